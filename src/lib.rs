@@ -1,0 +1,18 @@
+//! momaro: a closed-loop simulator of hybrid driving-stepping locomotion for the robot
+//! Momaro, after Klamt & Behnke, "Anytime Hybrid Driving-Stepping Locomotion Planning"
+//! (IROS 2017). See ARCHITECTURE.md for how the modules fit together.
+
+pub mod cli;
+pub mod control;
+pub mod geometry;
+pub mod jobs;
+pub mod monitor;
+pub mod params;
+pub mod planner;
+pub mod progress;
+pub mod robot;
+pub mod scenario;
+pub mod sim;
+pub mod stability;
+pub mod urdf_export;
+pub mod viz;

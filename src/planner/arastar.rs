@@ -1,0 +1,99 @@
+//! ARA*, Anytime Repairing A* (Likhachev, Gordon & Thrun, "ARA*: Anytime A* with
+//! Provable Bounds on Sub-Optimality", NIPS 2003), as used by Klamt & Behnke 2017,
+//! Sec. VII-B.
+//!
+//! A series of weighted-A* searches with `fvalue(s) = g(s) + ε·h(s)` and decreasing ε.
+//! Each search (`ImprovePath`, in `engine`) expands every state at most once; a state
+//! whose `g` improves after it was expanded goes into INCONS. Between searches ε
+//! decreases (exponentially, see [`SearchParams`]), INCONS moves into OPEN, OPEN is
+//! re-keyed and CLOSED emptied — so each search reuses all `g` values of the previous
+//! ones instead of starting over.
+//!
+//! Each finished search publishes a [`super::Solution`] whose cost is at most ε times the
+//! optimal cost (for a consistent heuristic; Likhachev et al. 2003, Theorem 1), together
+//! with the tighter bound ε′ = min(ε, cost / min_{OPEN ∪ INCONS}(g + h)). Published costs
+//! never increase: a solution always carries the best path known so far. The search
+//! ends when a search at `final_epsilon` finishes, when ε′ reaches 1, or at a limit
+//! (time, cancel, expansions, states), returning what it has.
+//!
+//! Fixed point: ε is held in thousandths, and keys are `g·1000 + ε_milli·h`
+//! ([`super::Cost`] micro-units × 1000), so weighting is exact integer arithmetic.
+
+use super::engine::{ClosedPolicy, EPS_ONE, Engine, suboptimality_bound};
+use super::{Hooks, SearchError, SearchGraph, SearchParams, SearchResult, Termination};
+
+/// Runs ARA* from `start` with the ε schedule and limits of `params`.
+///
+/// # Errors
+/// [`SearchError::Params`] if the ε fields of `params` are invalid.
+pub fn arastar<G: SearchGraph>(
+    graph: &mut G,
+    start: G::State,
+    params: &SearchParams,
+) -> Result<SearchResult<G::State>, SearchError> {
+    arastar_with_hooks(graph, start, params, Hooks::default())
+}
+
+/// [`arastar`] with a cancel flag, an expansion log and a solution callback (called as
+/// each solution is found, for anytime use).
+///
+/// # Errors
+/// [`SearchError::Params`] if the ε fields of `params` are invalid.
+pub fn arastar_with_hooks<G: SearchGraph>(
+    graph: &mut G,
+    start: G::State,
+    params: &SearchParams,
+    hooks: Hooks<'_, G::State>,
+) -> Result<SearchResult<G::State>, SearchError> {
+    let schedule = params.schedule()?;
+    // Fig. 3, lines 01'–02': g(start) = 0, OPEN = {start}, ε = ε₀.
+    let mut engine = Engine::new(
+        graph,
+        start,
+        params,
+        hooks,
+        schedule.initial,
+        ClosedPolicy::Incons,
+    );
+    if !engine.started() {
+        return Ok(engine.finish(Termination::StateLimit));
+    }
+    let mut best: Option<(Vec<G::State>, super::Cost)> = None;
+    let termination = loop {
+        // line 03' / 09': ImprovePath()
+        if let Err(stop) = engine.improve_path() {
+            break stop;
+        }
+        let Some(goal) = engine.goal else {
+            break Termination::NoPath; // OPEN ran empty without reaching a goal
+        };
+        // lines 04' / 10': ε′ and publish the current ε′-suboptimal solution
+        let lower = engine.lower_bound();
+        let (path, cost) = engine.path_to(goal);
+        if best.as_ref().is_none_or(|(_, c)| cost <= *c) {
+            best = Some((path, cost));
+        }
+        let Some((path, cost)) = best.clone() else {
+            break Termination::NoPath;
+        };
+        let bound = suboptimality_bound(engine.eps, cost, lower);
+        engine.publish(path, cost, bound);
+        // line 05': while ε′ > 1
+        if bound <= 1.0 {
+            break Termination::OptimalProven;
+        }
+        if engine.eps <= schedule.final_ {
+            break if schedule.final_ == EPS_ONE {
+                Termination::OptimalProven
+            } else {
+                Termination::FinalEpsilonReached
+            };
+        }
+        if let Some(stop) = engine.limits.check_now() {
+            break stop;
+        }
+        // lines 06'–08': decrease ε, move INCONS into OPEN, re-key OPEN, CLOSED = ∅
+        engine.next_iteration(schedule.next(engine.eps));
+    };
+    Ok(engine.finish(termination))
+}

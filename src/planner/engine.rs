@@ -1,0 +1,296 @@
+//! The best-first engine shared by A* and ARA*: ARA*'s `ImprovePath` (Likhachev, Gordon
+//! & Thrun 2003, Fig. 3) over the node store and the OPEN list, with the CLOSED set kept
+//! per iteration and the INCONS list.
+//!
+//! A* is the same loop at ε = 1 where an improved CLOSED state is re-opened instead of
+//! being parked in INCONS (A* with re-opening, optimal for any admissible heuristic).
+//! The drivers in `astar` and `arastar` own the outer loop.
+
+use super::nodes::{Limits, NodeId, NodeStore, path_cost, weighted_key};
+use super::open_list::{Entry, OpenList};
+use super::params::{EPS_SCALE, eps_to_f64};
+use super::result::{ExpandHook, SolutionHook};
+use super::{
+    Cost, Expansion, Hooks, SearchGraph, SearchParams, SearchResult, Solution, Termination,
+};
+
+/// What happens when a CLOSED state's `g` improves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ClosedPolicy {
+    /// A*: put it back into OPEN.
+    Reopen,
+    /// ARA*: park it in INCONS until the next iteration.
+    Incons,
+}
+
+/// The state of one search (all iterations).
+pub(crate) struct Engine<'g, 'h, G: SearchGraph> {
+    pub graph: &'g mut G,
+    pub store: NodeStore<G::State>,
+    pub open: OpenList,
+    /// ARA*'s INCONS: states whose `g` improved after they were closed this iteration.
+    pub incons: Vec<NodeId>,
+    succ: Vec<(G::State, Cost)>,
+    pub limits: Limits<'h>,
+    on_expand: Option<ExpandHook<'h, G::State>>,
+    on_solution: Option<SolutionHook<'h, G::State>>,
+    pub solutions: Vec<Solution<G::State>>,
+    pub expansions: u64,
+    /// ε in milli-units.
+    pub eps: u64,
+    /// Iteration number: a state is in CLOSED iff it was closed in this iteration.
+    pub iter: u32,
+    /// The goal state with the smallest `g` generated so far.
+    pub goal: Option<NodeId>,
+    policy: ClosedPolicy,
+}
+
+impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
+    /// Sets up a search from `start` (`g(start) = 0`, OPEN = {start}, CLOSED = INCONS = ∅;
+    /// Likhachev et al. 2003, Fig. 3, lines 01'–02'). If not even the start can be
+    /// stored (`max_states` = 0), [`Engine::started`] is false.
+    pub fn new(
+        graph: &'g mut G,
+        start: G::State,
+        params: &SearchParams,
+        hooks: Hooks<'h, G::State>,
+        eps: u64,
+        policy: ClosedPolicy,
+    ) -> Self {
+        let mut engine = Self {
+            graph,
+            store: NodeStore::new(params.max_states),
+            open: OpenList::new(),
+            incons: Vec::new(),
+            succ: Vec::with_capacity(32),
+            limits: Limits::new(params.time_limit, params.max_expansions, hooks.cancel),
+            on_expand: hooks.on_expand,
+            on_solution: hooks.on_solution,
+            solutions: Vec::new(),
+            expansions: 0,
+            eps,
+            iter: 0,
+            goal: None,
+            policy,
+        };
+        if let Some(id) = engine.store.get_or_insert(&*engine.graph, start) {
+            let n = engine.store.get_mut(id);
+            n.g = Cost::ZERO;
+            n.set_open(true);
+            let (h, goal) = (n.h, n.is_goal());
+            engine.open.push(Entry {
+                key: weighted_key(Cost::ZERO, h, eps),
+                h: h.0,
+                node: id,
+            });
+            if goal {
+                engine.goal = Some(id);
+            }
+        }
+        engine
+    }
+
+    /// Whether an OPEN entry is current: its state is still in OPEN with this key at `eps`.
+    #[inline]
+    fn is_valid(store: &NodeStore<G::State>, e: &Entry, eps: u64) -> bool {
+        let n = store.get(e.node);
+        n.in_open() && weighted_key(n.g, n.h, eps) == e.key
+    }
+
+    /// `ImprovePath()`: expand states in key order until the best goal's key is at most
+    /// the smallest key in OPEN (Likhachev et al. 2003, Fig. 3, line 02), or OPEN is
+    /// empty. `Err` with the reason when a limit stops it first.
+    pub fn improve_path(&mut self) -> Result<(), Termination> {
+        let eps = self.eps;
+        let iter = self.iter;
+        loop {
+            let store = &self.store;
+            let Some(top) = self.open.peek_valid(|e| Self::is_valid(store, e, eps)) else {
+                return Ok(()); // OPEN = ∅
+            };
+            if let Some(goal) = self.goal {
+                let gn = self.store.get(goal);
+                // while fvalue(s_goal) > min_{s ∈ OPEN} fvalue(s)
+                if weighted_key(gn.g, gn.h, eps) <= top.key {
+                    return Ok(());
+                }
+            }
+            if let Some(t) = self.limits.check(self.expansions) {
+                return Err(t);
+            }
+            // line 03: remove s with the smallest fvalue from OPEN; CLOSED = CLOSED ∪ {s}
+            self.open.pop_valid(|_| true);
+            let id = top.node;
+            let node = self.store.get_mut(id);
+            node.set_open(false);
+            node.close(iter);
+            let (state, g, h) = (node.state, node.g, node.h);
+            self.expansions += 1;
+            if let Some(log) = self.on_expand.as_deref_mut() {
+                log(&Expansion {
+                    state,
+                    g,
+                    h,
+                    epsilon: eps_to_f64(eps),
+                    iteration: iter,
+                    expansions: self.expansions,
+                });
+            }
+            // line 04: for each successor s' of s
+            self.succ.clear();
+            self.graph.successors(state, &mut self.succ);
+            for &(t, c) in &self.succ {
+                if c.is_infinite() {
+                    continue;
+                }
+                let ng = g.saturating_add(c);
+                if ng.is_infinite() {
+                    continue;
+                }
+                // lines 05–06: a state never visited before has g = ∞
+                let Some(tid) = self.store.get_or_insert(&*self.graph, t) else {
+                    return Err(Termination::StateLimit);
+                };
+                let best_goal_g = self.goal.map_or(Cost::INFINITY, |b| self.store.get(b).g);
+                let tn = self.store.get_mut(tid);
+                // line 07: if g(s') > g(s) + c(s, s')
+                if ng >= tn.g {
+                    continue;
+                }
+                tn.g = ng;
+                tn.parent = id;
+                if tn.is_goal() && ng < best_goal_g {
+                    self.goal = Some(tid);
+                }
+                if tn.closed_in(iter) {
+                    match self.policy {
+                        // line 11: else insert s' into INCONS
+                        ClosedPolicy::Incons => {
+                            if !tn.in_incons() {
+                                tn.set_incons(true);
+                                self.incons.push(tid);
+                            }
+                            continue;
+                        }
+                        ClosedPolicy::Reopen => tn.unclose(),
+                    }
+                }
+                // lines 09–10: if s' ∉ CLOSED, insert/update s' in OPEN with fvalue(s')
+                tn.set_open(true);
+                let h = tn.h;
+                self.open.push(Entry {
+                    key: weighted_key(ng, h, eps),
+                    h: h.0,
+                    node: tid,
+                });
+            }
+        }
+    }
+
+    /// `min_{s ∈ OPEN ∪ INCONS} (g(s) + h(s))`, a lower bound on the optimal cost for a
+    /// consistent heuristic (Likhachev et al. 2003, Sec. 4, ε′). ∞ if both are empty.
+    pub fn lower_bound(&self) -> Cost {
+        let open = self
+            .open
+            .iter()
+            .filter(|e| Self::is_valid(&self.store, e, self.eps))
+            .map(|e| e.node);
+        open.chain(self.incons.iter().copied())
+            .map(|id| {
+                let n = self.store.get(id);
+                n.g.saturating_add(n.h)
+            })
+            .min()
+            .unwrap_or(Cost::INFINITY)
+    }
+
+    /// The path to `goal` and its cost as the graph reports its edges.
+    pub fn path_to(&mut self, goal: NodeId) -> (Vec<G::State>, Cost) {
+        let ids = self.store.trace(goal);
+        let path: Vec<G::State> = ids.iter().map(|&i| self.store.get(i).state).collect();
+        let store = &self.store;
+        let cost = path_cost(&mut *self.graph, &path, &mut self.succ, |i| {
+            store.get(ids[i + 1]).g.saturating_sub(store.get(ids[i]).g)
+        });
+        (path, cost)
+    }
+
+    /// Records a solution (and streams it to the hook).
+    pub fn publish(&mut self, path: Vec<G::State>, cost: Cost, bound: f64) {
+        let sol = Solution {
+            path,
+            cost,
+            epsilon: eps_to_f64(self.eps),
+            suboptimality_bound: bound,
+            time: self.limits.elapsed(),
+            expansions: self.expansions,
+        };
+        if let Some(f) = self.on_solution.as_deref_mut() {
+            f(&sol);
+        }
+        self.solutions.push(sol);
+    }
+
+    /// ARA*, Fig. 3 lines 10'–12': move INCONS into OPEN, re-key OPEN with the new ε,
+    /// and start a new iteration (CLOSED = ∅). O(|OPEN| + |INCONS|).
+    pub fn next_iteration(&mut self, new_eps: u64) {
+        let old = self.eps;
+        let mut entries = self.open.take_entries();
+        let store = &self.store;
+        entries.retain_mut(|e| {
+            if Self::is_valid(store, e, old) {
+                let n = store.get(e.node);
+                e.key = weighted_key(n.g, n.h, new_eps);
+                true
+            } else {
+                false
+            }
+        });
+        for id in self.incons.drain(..) {
+            let n = self.store.get_mut(id);
+            n.set_incons(false);
+            if !n.in_open() {
+                n.set_open(true);
+                entries.push(Entry {
+                    key: weighted_key(n.g, n.h, new_eps),
+                    h: n.h.0,
+                    node: id,
+                });
+            }
+        }
+        self.open.rebuild(entries);
+        self.eps = new_eps;
+        self.iter += 1;
+    }
+
+    /// The final result.
+    pub fn finish(self, termination: Termination) -> SearchResult<G::State> {
+        SearchResult {
+            solutions: self.solutions,
+            termination,
+            expansions: self.expansions,
+            states: self.store.len(),
+            elapsed: self.limits.elapsed(),
+        }
+    }
+
+    /// Whether the start could be stored at all.
+    pub fn started(&self) -> bool {
+        self.store.len() > 0
+    }
+}
+
+/// `min(ε, cost / lower_bound)`, at least 1.
+pub(crate) fn suboptimality_bound(eps: u64, cost: Cost, lower_bound: Cost) -> f64 {
+    let e = eps_to_f64(eps);
+    if lower_bound >= cost {
+        return 1.0;
+    }
+    if lower_bound == Cost::ZERO {
+        return e;
+    }
+    (cost.0 as f64 / lower_bound.0 as f64).clamp(1.0, e)
+}
+
+/// ε = 1 in milli-units.
+pub(crate) const EPS_ONE: u64 = EPS_SCALE;

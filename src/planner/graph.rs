@@ -1,0 +1,56 @@
+//! The one interface between the search and a problem: [`SearchGraph`].
+//!
+//! As in SBPL, the search knows states only as opaque values; the graph (the paper's
+//! "neighbour client", the hybrid pose lattice in `locomotion`) owns coordinates,
+//! successors, costs and the heuristic. Nothing here knows about robots.
+
+use super::Cost;
+use std::hash::Hash;
+
+/// A directed graph with non-negative edge costs, a goal test and a heuristic.
+///
+/// # Contract
+/// - [`successors`](Self::successors) *appends* `(state, edge cost)` pairs to `out`
+///   (the search clears `out` before each call and reuses it, so no allocation happens
+///   per expansion). Edges of cost [`Cost::INFINITY`] are ignored. The order of the
+///   successors must be deterministic: the search breaks ties by discovery order, so the
+///   same graph gives the same path bit for bit.
+/// - [`heuristic`](Self::heuristic) must be **admissible** (never above the true
+///   cost-to-go) for A* to return optimal paths, and **consistent**
+///   (`h(s) ≤ c(s, s') + h(s')` for every edge, `h(goal) = 0`) for ARA*'s
+///   ε-suboptimality bounds (Likhachev, Gordon & Thrun 2003, Theorem 1). A consistent
+///   heuristic is admissible. The search calls it once per state and caches the value.
+/// - [`is_goal`](Self::is_goal) may accept many states (e.g. any orientation at the goal
+///   cell). It is called once per state, when the state is first generated.
+///
+/// `successors` takes `&mut self` so a graph can cache lazily computed data (cost maps,
+/// step feasibility) while it is searched.
+pub trait SearchGraph {
+    /// A node of the graph. Small and `Copy`: the search stores one per generated state.
+    type State: Copy + Eq + Hash;
+
+    /// Appends every successor of `state` with the cost of the edge to it.
+    fn successors(&mut self, state: Self::State, out: &mut Vec<(Self::State, Cost)>);
+
+    /// A lower bound on the cost from `state` to the nearest goal (see the contract).
+    fn heuristic(&self, state: Self::State) -> Cost;
+
+    /// Whether `state` is a goal.
+    fn is_goal(&self, state: Self::State) -> bool;
+}
+
+impl<G: SearchGraph + ?Sized> SearchGraph for &mut G {
+    type State = G::State;
+
+    fn successors(&mut self, state: Self::State, out: &mut Vec<(Self::State, Cost)>) {
+        (**self).successors(state, out);
+    }
+
+    fn heuristic(&self, state: Self::State) -> Cost {
+        (**self).heuristic(state)
+    }
+
+    fn is_goal(&self, state: Self::State) -> bool {
+        (**self).is_goal(state)
+    }
+}

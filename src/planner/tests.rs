@@ -1,0 +1,636 @@
+//! Tests of A* and ARA* on hand-made graphs, random grids (proptest, against a plain
+//! Dijkstra), an unbounded grid (time limit, cancel), and for determinism.
+
+use super::*;
+use proptest::prelude::*;
+use std::collections::{BinaryHeap, HashMap};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+// ---------------------------------------------------------------- hand-made graphs
+
+/// A graph given as an edge list with an explicit heuristic table.
+#[derive(Debug, Clone)]
+struct Table {
+    edges: Vec<(u8, u8, u64)>,
+    h: Vec<u64>,
+    goal: u8,
+}
+
+impl SearchGraph for Table {
+    type State = u8;
+    fn successors(&mut self, s: u8, out: &mut Vec<(u8, Cost)>) {
+        for &(a, b, c) in &self.edges {
+            if a == s {
+                out.push((b, Cost(c * Cost::SCALE)));
+            }
+        }
+    }
+    fn heuristic(&self, s: u8) -> Cost {
+        Cost(self.h[s as usize] * Cost::SCALE)
+    }
+    fn is_goal(&self, s: u8) -> bool {
+        s == self.goal
+    }
+}
+
+const S: u8 = 0;
+const A: u8 = 1;
+const B: u8 = 2;
+const G: u8 = 3;
+
+/// S→A→G costs 6, S→B→G costs 4. h is consistent but badly underestimates at A, so
+/// weighted A* (ε = 3) takes the route through A; ARA* must then improve it.
+fn trap() -> Table {
+    Table {
+        edges: vec![(S, A, 1), (A, G, 5), (S, B, 3), (B, G, 1)],
+        h: vec![1, 0, 1, 0],
+        goal: G,
+    }
+}
+
+fn units(c: u64) -> Cost {
+    Cost(c * Cost::SCALE)
+}
+
+#[test]
+fn astar_finds_optimal_on_trap() {
+    let r = astar(&mut trap(), S, &SearchParams::default());
+    assert_eq!(r.termination, Termination::OptimalProven);
+    let best = r.best().expect("solution");
+    assert_eq!(best.path, vec![S, B, G]);
+    assert_eq!(best.cost, units(4));
+    assert_eq!(r.solutions.len(), 1);
+}
+
+#[test]
+fn weighted_astar_is_suboptimal_on_trap() {
+    let p = SearchParams {
+        initial_epsilon: 3.0,
+        final_epsilon: 3.0,
+        ..SearchParams::default()
+    };
+    let r = arastar(&mut trap(), S, &p).expect("valid params");
+    assert_eq!(r.termination, Termination::FinalEpsilonReached);
+    let best = r.best().expect("solution");
+    assert_eq!(best.path, vec![S, A, G]);
+    assert_eq!(best.cost, units(6));
+    assert_eq!(best.epsilon, 3.0);
+    // ε′ = 6 / min(g + h over OPEN) = 6 / (3 + 1).
+    assert!((best.suboptimality_bound - 1.5).abs() < 1e-12);
+}
+
+#[test]
+fn arastar_improves_the_trap_solution() {
+    let r = arastar(&mut trap(), S, &SearchParams::default()).expect("valid params");
+    assert_eq!(r.termination, Termination::OptimalProven);
+    let costs: Vec<Cost> = r.solutions.iter().map(|s| s.cost).collect();
+    assert_eq!(costs, vec![units(6), units(4)]);
+    assert_eq!(r.solutions[0].epsilon, 3.0);
+    assert_eq!(r.solutions[1].path, vec![S, B, G]);
+    assert_eq!(r.solutions[1].suboptimality_bound, 1.0);
+    // The second search reused the first: B was already in OPEN, only it was expanded.
+    assert_eq!(r.expansions, 3);
+}
+
+#[test]
+fn astar_reopens_for_inconsistent_admissible_heuristic() {
+    // S→A 6, S→B 2, B→A 2, A→G 10, S→C 15, C→G 0. h(A) = h(C) = 0 and h(B) = 12
+    // (exact) are admissible but not consistent: A is expanded via S (g 6) before B
+    // improves it to 4. Without re-opening A, the search would settle for S→C→G (15).
+    const C: u8 = 4;
+    let mut g = Table {
+        edges: vec![
+            (S, A, 6),
+            (S, B, 2),
+            (B, A, 2),
+            (A, G, 10),
+            (S, C, 15),
+            (C, G, 0),
+        ],
+        h: vec![0, 0, 12, 0, 0],
+        goal: G,
+    };
+    let r = astar(&mut g, S, &SearchParams::default());
+    let best = r.best().expect("solution");
+    assert_eq!(best.path, vec![S, B, A, G]);
+    assert_eq!(best.cost, units(14));
+}
+
+#[test]
+fn start_is_goal() {
+    let mut g = trap();
+    let r = astar(&mut g, G, &SearchParams::default());
+    assert_eq!(
+        r.best().map(|s| (s.path.clone(), s.cost)),
+        Some((vec![G], Cost::ZERO))
+    );
+    let r = arastar(&mut g, G, &SearchParams::default()).expect("valid");
+    assert_eq!(r.termination, Termination::OptimalProven);
+    assert_eq!(r.solutions.len(), 1);
+    assert_eq!(r.best().map(|s| s.cost), Some(Cost::ZERO));
+}
+
+#[test]
+fn unreachable_goal_reports_no_path() {
+    let mut g = Table {
+        edges: vec![(S, A, 1), (A, S, 1), (B, G, 1)],
+        h: vec![0; 4],
+        goal: G,
+    };
+    let r = astar(&mut g, S, &SearchParams::default());
+    assert_eq!(r.termination, Termination::NoPath);
+    assert!(r.solutions.is_empty());
+    let r = arastar(&mut g, S, &SearchParams::default()).expect("valid");
+    assert_eq!(r.termination, Termination::NoPath);
+    assert!(r.solutions.is_empty());
+    assert_eq!(r.expansions, 2);
+}
+
+/// Edges as in [`Table`], where a cost of `u64::MAX` means [`Cost::INFINITY`].
+struct WithInfinite(Vec<(u8, u8, u64)>);
+
+impl SearchGraph for WithInfinite {
+    type State = u8;
+    fn successors(&mut self, s: u8, out: &mut Vec<(u8, Cost)>) {
+        for &(a, b, c) in &self.0 {
+            if a == s {
+                let cost = if c == u64::MAX {
+                    Cost::INFINITY
+                } else {
+                    units(c)
+                };
+                out.push((b, cost));
+            }
+        }
+    }
+    fn heuristic(&self, _: u8) -> Cost {
+        Cost::ZERO
+    }
+    fn is_goal(&self, s: u8) -> bool {
+        s == G
+    }
+}
+
+#[test]
+fn infinite_edges_are_not_followed() {
+    let mut g = WithInfinite(vec![(S, G, u64::MAX), (S, A, 2), (A, G, 2)]);
+    let r = astar(&mut g, S, &SearchParams::default());
+    assert_eq!(
+        r.best().map(|s| (s.path.clone(), s.cost)),
+        Some((vec![S, A, G], units(4)))
+    );
+    let mut g = WithInfinite(vec![(S, G, u64::MAX)]);
+    let r = arastar(&mut g, S, &SearchParams::default()).expect("valid");
+    assert_eq!(r.termination, Termination::NoPath);
+}
+
+#[test]
+fn invalid_params_are_an_error() {
+    let p = SearchParams {
+        initial_epsilon: 0.9,
+        ..SearchParams::default()
+    };
+    assert!(matches!(
+        arastar(&mut trap(), S, &p),
+        Err(SearchError::Params(ParamsError::Epsilon { .. }))
+    ));
+}
+
+#[test]
+fn expansion_and_state_limits() {
+    let mut g = Unbounded;
+    let p = SearchParams {
+        max_expansions: Some(100),
+        ..SearchParams::default()
+    };
+    let r = astar(&mut g, (5, 0), &p);
+    assert_eq!(r.termination, Termination::ExpansionLimit);
+    assert_eq!(r.expansions, 100);
+    let p = SearchParams {
+        max_states: Some(50),
+        ..SearchParams::default()
+    };
+    let r = arastar(&mut g, (5, 0), &p).expect("valid");
+    assert_eq!(r.termination, Termination::StateLimit);
+    assert!(r.states <= 50);
+    let p = SearchParams {
+        max_states: Some(0),
+        ..SearchParams::default()
+    };
+    assert_eq!(
+        astar(&mut g, (5, 0), &p).termination,
+        Termination::StateLimit
+    );
+}
+
+#[test]
+fn hooks_see_every_expansion_and_solution() {
+    let mut expanded = Vec::new();
+    let mut log = |e: &Expansion<u8>| expanded.push((e.state, e.iteration));
+    let mut found = Vec::new();
+    let mut on_sol = |s: &Solution<u8>| found.push(s.cost);
+    let hooks = Hooks {
+        cancel: None,
+        on_expand: Some(&mut log),
+        on_solution: Some(&mut on_sol),
+    };
+    let r = arastar_with_hooks(&mut trap(), S, &SearchParams::default(), hooks).expect("valid");
+    assert_eq!(expanded, vec![(S, 0), (A, 0), (B, 1)]);
+    assert_eq!(
+        found,
+        r.solutions.iter().map(|s| s.cost).collect::<Vec<_>>()
+    );
+}
+
+// ---------------------------------------------------------------- grids
+
+/// A bounded 8-connected grid; `None` cells are blocked. Moving between cells costs the
+/// move length (1 or √2, in integer micro-units) times the mean of the two cell costs.
+/// The heuristic is the octile distance with the same integer lengths, the exact cost on
+/// an all-ones grid, hence consistent.
+#[derive(Debug, Clone)]
+struct Grid {
+    w: i32,
+    h: i32,
+    cells: Vec<Option<u8>>,
+    goal: (i32, i32),
+}
+
+const STRAIGHT: u64 = Cost::SCALE;
+const DIAGONAL: u64 = 1_414_214; // round(√2 · 10⁶)
+const DIRS8: [(i32, i32); 8] = [
+    (1, 0),
+    (1, 1),
+    (0, 1),
+    (-1, 1),
+    (-1, 0),
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+];
+
+fn octile(a: (i64, i64), b: (i64, i64)) -> Cost {
+    let (dx, dy) = ((a.0 - b.0).unsigned_abs(), (a.1 - b.1).unsigned_abs());
+    let (lo, hi) = (dx.min(dy), dx.max(dy));
+    Cost((hi - lo) * STRAIGHT + lo * DIAGONAL)
+}
+
+impl Grid {
+    fn cell(&self, x: i32, y: i32) -> Option<u8> {
+        if x < 0 || y < 0 || x >= self.w || y >= self.h {
+            return None;
+        }
+        self.cells[(y * self.w + x) as usize]
+    }
+}
+
+impl SearchGraph for Grid {
+    type State = (i32, i32);
+    fn successors(&mut self, (x, y): (i32, i32), out: &mut Vec<((i32, i32), Cost)>) {
+        let Some(here) = self.cell(x, y) else { return };
+        for (dx, dy) in DIRS8 {
+            if let Some(there) = self.cell(x + dx, y + dy) {
+                let len = if dx != 0 && dy != 0 {
+                    DIAGONAL
+                } else {
+                    STRAIGHT
+                };
+                let c = len * (u64::from(here) + u64::from(there)) / 2;
+                out.push(((x + dx, y + dy), Cost(c)));
+            }
+        }
+    }
+    fn heuristic(&self, (x, y): (i32, i32)) -> Cost {
+        octile(
+            (x.into(), y.into()),
+            (self.goal.0.into(), self.goal.1.into()),
+        )
+    }
+    fn is_goal(&self, s: (i32, i32)) -> bool {
+        s == self.goal
+    }
+}
+
+/// Plain Dijkstra over the graph's successors: the reference optimal cost.
+fn dijkstra<G: SearchGraph>(g: &mut G, start: G::State) -> Option<Cost>
+where
+    G::State: Ord,
+{
+    let mut dist: HashMap<G::State, Cost> = HashMap::new();
+    let mut heap = BinaryHeap::new();
+    dist.insert(start, Cost::ZERO);
+    heap.push(std::cmp::Reverse((Cost::ZERO, start)));
+    let mut out = Vec::new();
+    while let Some(std::cmp::Reverse((d, s))) = heap.pop() {
+        if dist.get(&s).is_some_and(|&best| d > best) {
+            continue;
+        }
+        if g.is_goal(s) {
+            return Some(d);
+        }
+        out.clear();
+        g.successors(s, &mut out);
+        for &(t, c) in &out {
+            let nd = d + c;
+            if dist.get(&t).is_none_or(|&best| nd < best) {
+                dist.insert(t, nd);
+                heap.push(std::cmp::Reverse((nd, t)));
+            }
+        }
+    }
+    None
+}
+
+/// Checks that consecutive states are joined by edges and the edge costs sum to `cost`.
+fn assert_valid_path<G: SearchGraph>(g: &mut G, start: G::State, sol: &Solution<G::State>)
+where
+    G::State: std::fmt::Debug,
+{
+    assert_eq!(sol.path.first(), Some(&start));
+    assert!(sol.path.last().is_some_and(|&s| g.is_goal(s)));
+    let mut total = Cost::ZERO;
+    let mut out = Vec::new();
+    for w in sol.path.windows(2) {
+        out.clear();
+        g.successors(w[0], &mut out);
+        let edge = out
+            .iter()
+            .filter(|(s, _)| *s == w[1])
+            .map(|&(_, c)| c)
+            .min();
+        assert!(edge.is_some(), "{:?} -> {:?} is not an edge", w[0], w[1]);
+        total += edge.unwrap_or(Cost::INFINITY);
+    }
+    assert_eq!(total, sol.cost);
+}
+
+fn grid_strategy() -> impl Strategy<Value = (Grid, (i32, i32))> {
+    (1i32..=14, 1i32..=14)
+        .prop_flat_map(|(w, h)| {
+            let n = (w * h) as usize;
+            (
+                Just((w, h)),
+                proptest::collection::vec(
+                    prop_oneof![1 => Just(None), 3 => (1u8..=9).prop_map(Some)],
+                    n,
+                ),
+                0..n,
+                0..n,
+            )
+        })
+        .prop_map(|((w, h), mut cells, s, g)| {
+            cells[s] = cells[s].or(Some(1));
+            cells[g] = cells[g].or(Some(1));
+            let at = |i: usize| (i as i32 % w, i as i32 / w);
+            let grid = Grid {
+                w,
+                h,
+                cells,
+                goal: at(g),
+            };
+            (grid, at(s))
+        })
+}
+
+fn eps_params(initial: f64, decay: f64) -> SearchParams {
+    SearchParams {
+        initial_epsilon: initial,
+        epsilon_decay: decay,
+        ..SearchParams::default()
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    #[test]
+    fn astar_matches_dijkstra((grid, start) in grid_strategy()) {
+        let optimal = dijkstra(&mut grid.clone(), start);
+        let mut g = grid.clone();
+        let r = astar(&mut g, start, &SearchParams::default());
+        match optimal {
+            None => {
+                prop_assert_eq!(r.termination, Termination::NoPath);
+                prop_assert!(r.solutions.is_empty());
+            }
+            Some(opt) => {
+                prop_assert_eq!(r.termination, Termination::OptimalProven);
+                let best = r.best().expect("solution");
+                prop_assert_eq!(best.cost, opt);
+                assert_valid_path(&mut g, start, best);
+            }
+        }
+    }
+
+    #[test]
+    fn arastar_bounds_and_monotone(
+        (grid, start) in grid_strategy(),
+        initial in 1.0f64..5.0,
+        decay in 0.2f64..0.9,
+    ) {
+        let optimal = dijkstra(&mut grid.clone(), start);
+        let mut g = grid.clone();
+        let r = arastar(&mut g, start, &eps_params(initial, decay)).expect("valid");
+        let Some(opt) = optimal else {
+            prop_assert_eq!(r.termination, Termination::NoPath);
+            prop_assert!(r.solutions.is_empty());
+            return Ok(());
+        };
+        prop_assert_eq!(r.termination, Termination::OptimalProven);
+        prop_assert!(!r.solutions.is_empty());
+        let mut prev: Option<&Solution<(i32, i32)>> = None;
+        for sol in &r.solutions {
+            assert_valid_path(&mut g, start, sol);
+            // cost ≤ ε · optimal (exact in integers: ε is in thousandths)
+            let eps_milli = (sol.epsilon * 1000.0).round() as u128;
+            prop_assert!(u128::from(sol.cost.0) * 1000 <= eps_milli * u128::from(opt.0),
+                "cost {} > ε {} × optimal {}", sol.cost, sol.epsilon, opt);
+            prop_assert!(sol.cost.to_f64() <= sol.suboptimality_bound * opt.to_f64() * (1.0 + 1e-9));
+            prop_assert!(sol.suboptimality_bound >= 1.0 && sol.suboptimality_bound <= sol.epsilon);
+            if let Some(p) = prev {
+                prop_assert!(sol.cost <= p.cost);
+                prop_assert!(sol.epsilon < p.epsilon);
+                prop_assert!(sol.expansions >= p.expansions);
+            }
+            prev = Some(sol);
+        }
+        let last = r.best().expect("solution");
+        prop_assert_eq!(last.cost, opt);
+        let astar_cost = astar(&mut grid.clone(), start, &SearchParams::default())
+            .best()
+            .map(|s| s.cost);
+        prop_assert_eq!(Some(last.cost), astar_cost);
+    }
+
+    #[test]
+    fn weighted_astar_within_bound((grid, start) in grid_strategy(), eps in 1.0f64..4.0) {
+        let p = SearchParams { initial_epsilon: eps, final_epsilon: eps, ..SearchParams::default() };
+        let mut g = grid.clone();
+        let r = arastar(&mut g, start, &p).expect("valid");
+        if let Some(opt) = dijkstra(&mut grid.clone(), start) {
+            let sol = r.best().expect("solution");
+            prop_assert_eq!(r.solutions.len(), 1);
+            let eps_milli = (sol.epsilon * 1000.0).round() as u128;
+            prop_assert!(u128::from(sol.cost.0) * 1000 <= eps_milli * u128::from(opt.0));
+            assert_valid_path(&mut g, start, sol);
+        } else {
+            prop_assert_eq!(r.termination, Termination::NoPath);
+        }
+    }
+}
+
+/// A deterministic pseudo-random 60 × 60 grid with obstacles.
+fn fixed_grid() -> Grid {
+    let (w, h) = (60, 60);
+    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+    let cells = (0..w * h)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            if x.is_multiple_of(5) {
+                None
+            } else {
+                Some((x % 7 + 1) as u8)
+            }
+        })
+        .collect::<Vec<_>>();
+    let mut grid = Grid {
+        w,
+        h,
+        cells,
+        goal: (w - 1, h - 1),
+    };
+    grid.cells[0] = Some(1);
+    let last = grid.cells.len() - 1;
+    grid.cells[last] = Some(1);
+    grid
+}
+
+#[test]
+fn same_graph_same_paths() {
+    let run = || {
+        let mut g = fixed_grid();
+        let r = arastar(&mut g, (0, 0), &SearchParams::default()).expect("valid");
+        let a = astar(&mut g, (0, 0), &SearchParams::default());
+        let sols: Vec<_> = r
+            .solutions
+            .into_iter()
+            .map(|s| (s.path, s.cost, s.epsilon, s.expansions))
+            .collect();
+        (
+            sols,
+            a.best().map(|s| s.path.clone()),
+            r.expansions,
+            a.expansions,
+        )
+    };
+    let first = run();
+    assert!(!first.0.is_empty(), "fixed grid must be solvable");
+    assert!(
+        first.0.len() > 1,
+        "ARA* should improve at least once on the fixed grid"
+    );
+    assert_eq!(first, run());
+}
+
+// ---------------------------------------------------------------- unbounded graph
+
+/// An unbounded 4-connected grid of unit cost whose goal (0, 0) is walled in by the
+/// ring of cells at Chebyshev distance 1: the search can never finish on its own.
+struct Unbounded;
+
+impl SearchGraph for Unbounded {
+    type State = (i64, i64);
+    fn successors(&mut self, (x, y): (i64, i64), out: &mut Vec<((i64, i64), Cost)>) {
+        for (dx, dy) in [(1, 0), (0, 1), (-1, 0), (0, -1)] {
+            let (nx, ny) = (x + dx, y + dy);
+            if nx.abs().max(ny.abs()) != 1 {
+                out.push(((nx, ny), Cost::ONE));
+            }
+        }
+    }
+    fn heuristic(&self, (x, y): (i64, i64)) -> Cost {
+        Cost((x.unsigned_abs() + y.unsigned_abs()) * Cost::SCALE)
+    }
+    fn is_goal(&self, s: (i64, i64)) -> bool {
+        s == (0, 0)
+    }
+}
+
+#[test]
+fn time_limit_holds_on_unbounded_graph() {
+    let limit = Duration::from_millis(200);
+    let p = SearchParams {
+        time_limit: Some(limit),
+        max_states: Some(20_000_000), // a backstop should the limit fail
+        ..SearchParams::default()
+    };
+    let t = Instant::now();
+    let r = arastar(&mut Unbounded, (5, 3), &p).expect("valid");
+    let took = t.elapsed();
+    assert_eq!(r.termination, Termination::TimeLimit);
+    assert!(r.solutions.is_empty());
+    assert!(took < 5 * limit, "took {took:?}");
+    assert!(took >= limit);
+
+    let t = Instant::now();
+    let r = astar(&mut Unbounded, (5, 3), &p);
+    assert_eq!(r.termination, Termination::TimeLimit);
+    assert!(t.elapsed() < 5 * limit, "took {:?}", t.elapsed());
+}
+
+#[test]
+fn cancel_flag_stops_search() {
+    let flag = AtomicBool::new(false);
+    let p = SearchParams {
+        max_states: Some(20_000_000), // a backstop should the flag be ignored
+        ..SearchParams::default()
+    };
+    let t = Instant::now();
+    let r = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            std::thread::sleep(Duration::from_millis(100));
+            flag.store(true, Ordering::Relaxed);
+        });
+        let hooks = Hooks {
+            cancel: Some(&flag),
+            ..Hooks::default()
+        };
+        arastar_with_hooks(&mut Unbounded, (5, 3), &p, hooks).expect("valid")
+    });
+    assert_eq!(r.termination, Termination::Cancelled);
+    assert!(r.expansions > 0);
+    assert!(
+        t.elapsed() < Duration::from_secs(2),
+        "took {:?}",
+        t.elapsed()
+    );
+
+    // Already raised: stops before the first expansion.
+    let hooks = Hooks {
+        cancel: Some(&flag),
+        ..Hooks::default()
+    };
+    let r = astar_with_hooks(&mut Unbounded, (5, 3), &p, hooks);
+    assert_eq!(r.termination, Termination::Cancelled);
+    assert_eq!(r.expansions, 0);
+}
+
+#[test]
+fn time_limit_keeps_anytime_solutions() {
+    // A limit that ends ARA* somewhere in its iterations still returns what it found,
+    // with non-increasing costs, and the termination is the limit or optimality.
+    let mut g = fixed_grid();
+    let p = SearchParams {
+        time_limit: Some(Duration::from_millis(5)),
+        ..SearchParams::default()
+    };
+    let r = arastar(&mut g, (0, 0), &p).expect("valid");
+    assert!(matches!(
+        r.termination,
+        Termination::TimeLimit | Termination::OptimalProven
+    ));
+    assert!(r.solutions.windows(2).all(|w| w[1].cost <= w[0].cost));
+}

@@ -1,0 +1,126 @@
+//! What the planner and controllers know of the robot: its kinematic description, read
+//! once from the compiled MuJoCo model by `sim::model` and never typed a second time.
+//!
+//! Legs are indexed FL, FR, RL, RR (see [`Leg`]). Each leg has three pitch joints (hip,
+//! knee, ankle) moving the foot in the leg's sagittal plane (the base x'–z' plane at the
+//! hip's y'), a steering (yaw) joint, and a pair of driven wheels. A *foot* position is the
+//! ground contact point under the centre of the wheel pair.
+
+pub mod ik;
+
+use serde::Serialize;
+
+/// A leg of the robot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub enum Leg {
+    /// Front left.
+    FrontLeft = 0,
+    /// Front right.
+    FrontRight = 1,
+    /// Rear left.
+    RearLeft = 2,
+    /// Rear right.
+    RearRight = 3,
+}
+
+impl Leg {
+    /// All legs in index order.
+    pub const ALL: [Leg; 4] = [Leg::FrontLeft, Leg::FrontRight, Leg::RearLeft, Leg::RearRight];
+
+    /// Index 0..4.
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Short name used in the model's element names: `fl`, `fr`, `rl`, `rr`.
+    pub const fn prefix(self) -> &'static str {
+        match self {
+            Leg::FrontLeft => "fl",
+            Leg::FrontRight => "fr",
+            Leg::RearLeft => "rl",
+            Leg::RearRight => "rr",
+        }
+    }
+
+    /// Whether the leg is a front leg.
+    pub const fn is_front(self) -> bool {
+        matches!(self, Leg::FrontLeft | Leg::FrontRight)
+    }
+
+    /// Whether the leg is on the left side.
+    pub const fn is_left(self) -> bool {
+        matches!(self, Leg::FrontLeft | Leg::RearLeft)
+    }
+
+    /// The other leg on the same side.
+    pub const fn same_side_partner(self) -> Leg {
+        match self {
+            Leg::FrontLeft => Leg::RearLeft,
+            Leg::FrontRight => Leg::RearRight,
+            Leg::RearLeft => Leg::FrontLeft,
+            Leg::RearRight => Leg::FrontRight,
+        }
+    }
+}
+
+/// A closed interval `[min, max]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Range {
+    /// Lower bound.
+    pub min: f64,
+    /// Upper bound.
+    pub max: f64,
+}
+
+impl Range {
+    /// Whether `v` lies in the interval.
+    pub fn contains(&self, v: f64) -> bool {
+        v >= self.min && v <= self.max
+    }
+}
+
+/// Kinematic and inertial description of Momaro, as compiled by MuJoCo.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RobotDescription {
+    /// Hip pitch axis position in the base frame (x', y', z'), m, per leg.
+    pub hips: [[f64; 3]; 4],
+    /// Hip-to-knee length, m.
+    pub thigh_length: f64,
+    /// Knee-to-ankle length, m.
+    pub shin_length: f64,
+    /// Ankle-to-wheel-axle length, m (the foot segment, vertical when the wheel is level).
+    pub foot_length: f64,
+    /// Wheel radius, m.
+    pub wheel_radius: f64,
+    /// Lateral distance between the two wheels of a pair, m.
+    pub wheel_track: f64,
+    /// Hip, knee and ankle joint ranges, rad (same for all legs).
+    pub joint_ranges: [Range; 3],
+    /// Foot x' offset from the hip in the neutral driving footprint, m, per leg.
+    pub neutral_foot_offset_x: [f64; 4],
+    /// Half extents of the base box (x', y', z'), m.
+    pub base_half_extents: [f64; 3],
+    /// Height of the base's underside above the hip axes, m (negative: below).
+    pub base_bottom_z: f64,
+    /// Total mass, kg.
+    pub total_mass: f64,
+}
+
+impl RobotDescription {
+    /// Neutral foot positions (x', y') in the base frame, per leg.
+    pub fn neutral_footprint(&self) -> [[f64; 2]; 4] {
+        std::array::from_fn(|i| [self.hips[i][0] + self.neutral_foot_offset_x[i], self.hips[i][1]])
+    }
+
+    /// Longest hip-to-ground distance with a straight leg and level wheel, m.
+    pub fn max_leg_length(&self) -> f64 {
+        self.thigh_length + self.shin_length + self.foot_length + self.wheel_radius
+    }
+
+    /// x' offsets of the centres of the two circles that approximate the base (Sec. IV),
+    /// for circles of radius `radius` inscribed at the two ends of the base box.
+    pub fn base_circle_centres_x(&self, radius: f64) -> [f64; 2] {
+        let d = (self.base_half_extents[0] - radius).max(0.0);
+        [d, -d]
+    }
+}

@@ -1,0 +1,422 @@
+//! Scenario files: terrain, map extent, start and goal, parameter overrides, expectations.
+//!
+//! A scenario is a TOML file (format documented in `scenarios/README.md`). Loading parses
+//! it strictly (unknown keys are errors) and validates every number, so a broken file
+//! fails here with its path and the offending field, never later as a panic or a silently
+//! wrong plan. The terrain primitives feed both the MuJoCo world (`sim::world`) and the
+//! rasterised height map (`terrain`).
+
+pub mod terrain;
+
+use crate::geometry::Pose2;
+use crate::params::Params;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+pub use terrain::Primitive;
+
+/// Why a scenario could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("cannot read scenario {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML or does not match the format (wrong type, unknown key).
+    #[error("malformed scenario {path}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// The parser's message, naming the key and line.
+        message: String,
+    },
+    /// A value is out of range.
+    #[error("invalid scenario {path}: field `{field}`: {reason}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// Dotted path of the field, e.g. `terrain[2].size`.
+        field: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+}
+
+/// Rectangular extent of the map, m.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapExtent {
+    /// Lower x bound.
+    pub x_min: f64,
+    /// Upper x bound.
+    pub x_max: f64,
+    /// Lower y bound.
+    pub y_min: f64,
+    /// Upper y bound.
+    pub y_max: f64,
+}
+
+impl MapExtent {
+    /// Whether (x, y) lies inside the extent.
+    pub fn contains(&self, x: f64, y: f64) -> bool {
+        x >= self.x_min && x <= self.x_max && y >= self.y_min && y <= self.y_max
+    }
+}
+
+/// A pose as written in a scenario: position in metres, yaw in degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseSpec {
+    /// x, m.
+    pub x: f64,
+    /// y, m.
+    pub y: f64,
+    /// Yaw, degrees, counter-clockwise from +x.
+    #[serde(default)]
+    pub yaw_deg: f64,
+}
+
+impl PoseSpec {
+    /// As a planar pose (yaw in radians).
+    pub fn pose(&self) -> Pose2 {
+        Pose2::new(self.x, self.y, self.yaw_deg.to_radians())
+    }
+}
+
+/// Whether a scenario's plan must, may or must not contain steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stepping {
+    /// No expectation.
+    #[default]
+    Any,
+    /// The plan must contain at least one step.
+    Required,
+    /// The plan must drive only.
+    Forbidden,
+}
+
+/// What a closed-loop run of the scenario must show to pass.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Expectations {
+    /// The robot must reach the goal within the tolerances.
+    pub reach_goal: bool,
+    /// Position tolerance at the goal, m.
+    pub goal_tolerance_m: f64,
+    /// Heading tolerance at the goal, degrees.
+    pub goal_tolerance_deg: f64,
+    /// Whether the plan must or must not step.
+    pub stepping: Stepping,
+    /// Minimum static stability margin measured during the run, m.
+    pub min_stability_margin_m: f64,
+    /// Simulated-time budget of a run, s.
+    pub timeout_s: f64,
+}
+
+impl Default for Expectations {
+    fn default() -> Self {
+        Self {
+            reach_goal: true,
+            goal_tolerance_m: 0.1,
+            goal_tolerance_deg: 10.0,
+            stepping: Stepping::Any,
+            min_stability_margin_m: 0.0,
+            timeout_s: 120.0,
+        }
+    }
+}
+
+/// The file format, exactly as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScenarioFile {
+    name: Option<String>,
+    #[serde(default)]
+    description: String,
+    map: MapExtent,
+    start: PoseSpec,
+    goal: PoseSpec,
+    #[serde(default)]
+    terrain: Vec<Primitive>,
+    #[serde(default)]
+    params: Params,
+    #[serde(default)]
+    expect: Expectations,
+}
+
+/// A loaded, validated scenario.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Scenario {
+    /// Name (the file stem unless given).
+    pub name: String,
+    /// Where it was loaded from.
+    pub path: PathBuf,
+    /// One-line description.
+    pub description: String,
+    /// Map extent.
+    pub map: MapExtent,
+    /// Start pose.
+    pub start: Pose2,
+    /// Goal pose.
+    pub goal: Pose2,
+    /// Terrain primitives on the ground plane.
+    pub terrain: Vec<Primitive>,
+    /// The paper's parameters with this scenario's overrides.
+    pub params: Params,
+    /// What a run must show.
+    pub expect: Expectations,
+}
+
+impl Scenario {
+    /// Reads and validates a scenario file.
+    ///
+    /// # Errors
+    /// [`ScenarioError`] naming the file and, for bad values, the field.
+    pub fn load(path: &Path) -> Result<Self, ScenarioError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ScenarioError::Io { path: path.to_owned(), source })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses and validates scenario text; `path` is used for the name and in errors.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Parse`] or [`ScenarioError::Invalid`].
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ScenarioError> {
+        let file: ScenarioFile = toml::from_str(text).map_err(|e| ScenarioError::Parse {
+            path: path.to_owned(),
+            message: e.to_string().trim_end().replace('\n', " "),
+        })?;
+        let invalid = |field: &str, reason: String| ScenarioError::Invalid {
+            path: path.to_owned(),
+            field: field.to_owned(),
+            reason,
+        };
+        validate(&file).map_err(|(field, reason)| invalid(&field, reason))?;
+        let name = file.name.clone().unwrap_or_else(|| {
+            path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+        });
+        Ok(Scenario {
+            name,
+            path: path.to_owned(),
+            description: file.description,
+            map: file.map,
+            start: file.start.pose(),
+            goal: file.goal.pose(),
+            terrain: file.terrain,
+            params: file.params,
+            expect: file.expect,
+        })
+    }
+
+    /// Terrain height at (x, y): ground plane and primitives.
+    pub fn terrain_height(&self, x: f64, y: f64) -> f64 {
+        terrain::terrain_height(&self.terrain, x, y)
+    }
+}
+
+type FieldError = (String, String);
+
+fn finite(field: &str, v: f64) -> Result<(), FieldError> {
+    if v.is_finite() { Ok(()) } else { Err((field.to_owned(), format!("{v} is not a finite number"))) }
+}
+
+fn positive(field: &str, v: f64) -> Result<(), FieldError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err((field.to_owned(), format!("{v} must be a finite number > 0")))
+    }
+}
+
+fn non_negative(field: &str, v: f64) -> Result<(), FieldError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err((field.to_owned(), format!("{v} must be a finite number >= 0")))
+    }
+}
+
+fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
+    let m = &f.map;
+    for (name, v) in [("map.x_min", m.x_min), ("map.x_max", m.x_max), ("map.y_min", m.y_min), ("map.y_max", m.y_max)] {
+        finite(name, v)?;
+    }
+    if m.x_max <= m.x_min {
+        return Err(("map.x_max".into(), format!("{} must exceed map.x_min = {}", m.x_max, m.x_min)));
+    }
+    if m.y_max <= m.y_min {
+        return Err(("map.y_max".into(), format!("{} must exceed map.y_min = {}", m.y_max, m.y_min)));
+    }
+    for (name, p) in [("start", &f.start), ("goal", &f.goal)] {
+        finite(&format!("{name}.x"), p.x)?;
+        finite(&format!("{name}.y"), p.y)?;
+        finite(&format!("{name}.yaw_deg"), p.yaw_deg)?;
+        if !m.contains(p.x, p.y) {
+            return Err((
+                name.into(),
+                format!(
+                    "({}, {}) lies outside the map [{}, {}] x [{}, {}]",
+                    p.x, p.y, m.x_min, m.x_max, m.y_min, m.y_max
+                ),
+            ));
+        }
+    }
+    for (i, prim) in f.terrain.iter().enumerate() {
+        validate_primitive(&format!("terrain[{i}]"), prim)?;
+    }
+    f.params.validate().map_err(|e| (format!("params.{}", e.name), format!("{} {}", e.value, e.reason)))?;
+    // The base would be inside a solid taller than the clearance under it while driving.
+    for (name, p) in [("start", &f.start), ("goal", &f.goal)] {
+        for (i, prim) in f.terrain.iter().enumerate() {
+            if let Some(h) = prim.surface_height(p.x, p.y)
+                && h > f.params.driving_leg_height_m
+            {
+                return Err((
+                    name.into(),
+                    format!(
+                        "({}, {}) lies inside terrain[{i}] ({}, {h:.2} m tall): the robot would start inside an obstacle",
+                        p.x,
+                        p.y,
+                        prim.kind()
+                    ),
+                ));
+            }
+        }
+    }
+    let e = &f.expect;
+    non_negative("expect.goal_tolerance_m", e.goal_tolerance_m)?;
+    non_negative("expect.goal_tolerance_deg", e.goal_tolerance_deg)?;
+    finite("expect.min_stability_margin_m", e.min_stability_margin_m)?;
+    positive("expect.timeout_s", e.timeout_s)?;
+    Ok(())
+}
+
+fn validate_primitive(at: &str, p: &Primitive) -> Result<(), FieldError> {
+    match *p {
+        Primitive::Box { center, size, height, yaw_deg }
+        | Primitive::Ramp { center, size, height, yaw_deg } => {
+            finite(&format!("{at}.center"), center[0])?;
+            finite(&format!("{at}.center"), center[1])?;
+            positive(&format!("{at}.size"), size[0])?;
+            positive(&format!("{at}.size"), size[1])?;
+            positive(&format!("{at}.height"), height)?;
+            finite(&format!("{at}.yaw_deg"), yaw_deg)?;
+        }
+        Primitive::Stairs { start, width, steps, step_depth, step_height, landing_depth, yaw_deg } => {
+            finite(&format!("{at}.start"), start[0])?;
+            finite(&format!("{at}.start"), start[1])?;
+            positive(&format!("{at}.width"), width)?;
+            if steps == 0 {
+                return Err((format!("{at}.steps"), "must be at least 1".into()));
+            }
+            positive(&format!("{at}.step_depth"), step_depth)?;
+            positive(&format!("{at}.step_height"), step_height)?;
+            non_negative(&format!("{at}.landing_depth"), landing_depth)?;
+            finite(&format!("{at}.yaw_deg"), yaw_deg)?;
+        }
+        Primitive::Pole { center, radius, height } => {
+            finite(&format!("{at}.center"), center[0])?;
+            finite(&format!("{at}.center"), center[1])?;
+            positive(&format!("{at}.radius"), radius)?;
+            positive(&format!("{at}.height"), height)?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+        [map]
+        x_min = -1.0
+        x_max = 5.0
+        y_min = -2.0
+        y_max = 2.0
+        [start]
+        x = 0.0
+        y = 0.0
+        [goal]
+        x = 4.0
+        y = 0.5
+        yaw_deg = 90
+        [[terrain]]
+        kind = "box"
+        center = [2.0, 1.5]
+        size = [0.5, 0.5]
+        height = 0.2
+        [params]
+        k12 = 1.5
+    "#;
+
+    fn parse(text: &str) -> Result<Scenario, ScenarioError> {
+        Scenario::parse(text, Path::new("scenarios/test.toml"))
+    }
+
+    fn field_of(text: &str) -> String {
+        match parse(text) {
+            Err(ScenarioError::Invalid { field, .. }) => field,
+            other => panic!("expected an invalid-field error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn good_file_parses_with_overrides_and_defaults() {
+        let s = parse(GOOD).unwrap();
+        assert_eq!(s.name, "test");
+        assert_eq!(s.params.k12, 1.5);
+        assert_eq!(s.params.k1, 100.0);
+        assert!((s.goal.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert!(s.expect.reach_goal);
+        assert_eq!(s.terrain_height(2.0, 1.5), 0.2);
+    }
+
+    #[test]
+    fn unknown_key_names_the_key_and_file() {
+        let e = parse(&GOOD.replace("[params]", "[params]\nk99 = 1")).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains("k99") && msg.contains("scenarios/test.toml"), "{msg}");
+    }
+
+    #[test]
+    fn wrong_type_is_a_parse_error_naming_the_key() {
+        let e = parse(&GOOD.replace("x = 4.0", "x = \"far\"")).unwrap_err();
+        assert!(matches!(e, ScenarioError::Parse { .. }));
+        assert!(e.to_string().contains("x"), "{e}");
+    }
+
+    #[test]
+    fn negative_size_names_the_field() {
+        assert_eq!(field_of(&GOOD.replace("size = [0.5, 0.5]", "size = [-0.5, 0.5]")), "terrain[0].size");
+    }
+
+    #[test]
+    fn goal_outside_map_is_rejected() {
+        assert_eq!(field_of(&GOOD.replace("x = 4.0", "x = 40.0")), "goal");
+    }
+
+    #[test]
+    fn nan_is_rejected() {
+        assert_eq!(field_of(&GOOD.replace("y = 0.5", "y = nan")), "goal.y");
+        assert_eq!(field_of(&GOOD.replace("k12 = 1.5", "k12 = nan")), "params.k12");
+    }
+
+    #[test]
+    fn start_inside_an_obstacle_is_rejected() {
+        let text = GOOD.replace("center = [2.0, 1.5]", "center = [0.0, 0.0]").replace("height = 0.2", "height = 0.5");
+        assert_eq!(field_of(&text), "start");
+    }
+
+    #[test]
+    fn missing_file_is_an_io_error_naming_it() {
+        let e = Scenario::load(Path::new("/nonexistent/x.toml")).unwrap_err();
+        assert!(matches!(e, ScenarioError::Io { .. }));
+        assert!(e.to_string().contains("/nonexistent/x.toml"));
+    }
+}

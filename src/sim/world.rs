@@ -1,0 +1,118 @@
+//! Builds the MJCF of a scenario's world: the robot model file, included, plus the ground
+//! plane and one geom per terrain solid.
+//!
+//! The text is generated deterministically from the scenario, so two runs of a scenario
+//! simulate the same world bit for bit. Ramps are convex triangular-prism meshes; boxes and
+//! stair treads are boxes; poles are cylinders. Terrain geoms carry contype 1 / conaffinity 2
+//! and group 0 (see `models/momaro.xml` for the robot's side of that contract).
+
+use crate::scenario::{MapExtent, Primitive};
+use std::fmt::Write as _;
+
+/// File name under which the robot model is placed in MuJoCo's virtual file system.
+pub const ROBOT_FILE: &str = "momaro.xml";
+
+/// Prefix of every terrain geom's name; the floor is `terrain_floor`.
+pub const TERRAIN_PREFIX: &str = "terrain_";
+
+const TERRAIN_GEOM: &str =
+    r#"contype="1" conaffinity="2" group="0" friction="1.0 0.02 0.001" rgba="0.62 0.6 0.55 1""#;
+
+/// The world MJCF for a map extent and terrain, including `ROBOT_FILE`.
+pub fn world_xml(name: &str, map: &MapExtent, terrain: &[Primitive]) -> String {
+    let mut assets = String::new();
+    let mut geoms = String::new();
+    let (cx, cy) = ((map.x_min + map.x_max) / 2.0, (map.y_min + map.y_max) / 2.0);
+    let (hx, hy) = ((map.x_max - map.x_min) / 2.0 + 2.0, (map.y_max - map.y_min) / 2.0 + 2.0);
+    // The plane is infinite for collision; `size` only bounds its drawing.
+    let _ = writeln!(
+        geoms,
+        r#"    <geom name="{TERRAIN_PREFIX}floor" type="plane" pos="{cx} {cy} 0" size="{hx} {hy} 0.1" {TERRAIN_GEOM}/>"#
+    );
+    for (i, prim) in terrain.iter().enumerate() {
+        match *prim {
+            Primitive::Box { .. } | Primitive::Stairs { .. } => {
+                for (k, b) in prim.blocks().iter().enumerate() {
+                    let _ = writeln!(
+                        geoms,
+                        r#"    <geom name="{TERRAIN_PREFIX}{i}_{k}" type="box" pos="{} {} {}" size="{} {} {}" euler="0 0 {}" {TERRAIN_GEOM}/>"#,
+                        b.center[0],
+                        b.center[1],
+                        b.height / 2.0,
+                        b.half_size[0],
+                        b.half_size[1],
+                        b.height / 2.0,
+                        b.yaw
+                    );
+                }
+            }
+            Primitive::Ramp { center, size, height, yaw_deg } => {
+                let (hx, hy) = (size[0] / 2.0, size[1] / 2.0);
+                // Triangular prism: low edge at local x = -hx on the ground, high edge at +hx.
+                let _ = writeln!(
+                    assets,
+                    r#"    <mesh name="{TERRAIN_PREFIX}ramp_{i}" vertex="{mx} {my} 0  {mx} {hy} 0  {hx} {my} 0  {hx} {hy} 0  {hx} {my} {height}  {hx} {hy} {height}"/>"#,
+                    mx = -hx,
+                    my = -hy,
+                );
+                let _ = writeln!(
+                    geoms,
+                    r#"    <geom name="{TERRAIN_PREFIX}{i}" type="mesh" mesh="{TERRAIN_PREFIX}ramp_{i}" pos="{} {} 0" euler="0 0 {}" {TERRAIN_GEOM}/>"#,
+                    center[0],
+                    center[1],
+                    yaw_deg.to_radians()
+                );
+            }
+            Primitive::Pole { center, radius, height } => {
+                let _ = writeln!(
+                    geoms,
+                    r#"    <geom name="{TERRAIN_PREFIX}{i}" type="cylinder" pos="{} {} {}" size="{radius} {}" {TERRAIN_GEOM}/>"#,
+                    center[0],
+                    center[1],
+                    height / 2.0,
+                    height / 2.0
+                );
+            }
+        }
+    }
+    format!(
+        r#"<mujoco model="momaro_{name}">
+  <include file="{ROBOT_FILE}"/>
+  <visual><global offwidth="1280" offheight="720"/></visual>
+  <asset>
+{assets}  </asset>
+  <worldbody>
+    <light pos="0 0 5" dir="0 0 -1" directional="true"/>
+{geoms}  </worldbody>
+</mujoco>
+"#
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_geom_per_solid_and_deterministic() {
+        let map = MapExtent { x_min: 0.0, x_max: 4.0, y_min: -1.0, y_max: 1.0 };
+        let terrain = vec![
+            Primitive::Box { center: [1.0, 0.0], size: [0.5, 0.5], height: 0.2, yaw_deg: 0.0 },
+            Primitive::Ramp { center: [2.0, 0.0], size: [1.0, 1.0], height: 0.2, yaw_deg: 90.0 },
+            Primitive::Stairs {
+                start: [3.0, 0.0],
+                width: 1.0,
+                steps: 2,
+                step_depth: 0.3,
+                step_height: 0.15,
+                landing_depth: 0.0,
+                yaw_deg: 0.0,
+            },
+            Primitive::Pole { center: [0.5, 0.5], radius: 0.05, height: 0.6 },
+        ];
+        let xml = world_xml("t", &map, &terrain);
+        assert_eq!(xml.matches("<geom ").count(), 1 + 1 + 1 + 2 + 1);
+        assert_eq!(xml.matches("<mesh ").count(), 1);
+        assert_eq!(xml, world_xml("t", &map, &terrain));
+    }
+}

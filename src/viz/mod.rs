@@ -1,0 +1,199 @@
+//! Rerun recordings (.rrd): the only module that imports rerun.
+//!
+//! Layout of a recording, on the `sim_time` timeline (seconds of simulated time):
+//! - `world/terrain/<geom>`: terrain shapes, static;
+//! - `world/robot/<body>`: one transform per body over time, its geoms static beneath it;
+//! - `world/stability/com` (CoM projected on the ground), `world/stability/support_polygon`;
+//! - `plots/stability_margin_m`: the margin as a time series;
+//! - `world/plan/...` and `maps/...`: plans and cost layers, where a job logs them.
+
+use crate::monitor::StabilitySample;
+use crate::sim::{BodyPose, GeomKind, GeomShape};
+use std::path::{Path, PathBuf};
+
+/// Name of the timeline of simulated time.
+pub const SIM_TIME: &str = "sim_time";
+
+/// A recording could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum VizError {
+    /// Opening or writing the file failed.
+    #[error("cannot write recording {path}: {message}")]
+    Write {
+        /// The .rrd file.
+        path: PathBuf,
+        /// Rerun's message.
+        message: String,
+    },
+}
+
+/// An open .rrd recording.
+pub struct Recorder {
+    rec: rerun::RecordingStream,
+    path: PathBuf,
+    body_names: Vec<String>,
+}
+
+impl std::fmt::Debug for Recorder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Recorder").field("path", &self.path).finish_non_exhaustive()
+    }
+}
+
+fn rgba_u8(c: [f32; 4]) -> rerun::Color {
+    let [r, g, b, a] = albedo(c);
+    rerun::Color::from_unmultiplied_rgba(r, g, b, a)
+}
+
+fn albedo(c: [f32; 4]) -> [u8; 4] {
+    c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+}
+
+fn v3(p: [f64; 3]) -> [f32; 3] {
+    [p[0] as f32, p[1] as f32, p[2] as f32]
+}
+
+fn quat(q: [f64; 4]) -> rerun::Quaternion {
+    // MuJoCo stores (w, x, y, z); rerun takes (x, y, z, w).
+    rerun::Quaternion::from_xyzw([q[1] as f32, q[2] as f32, q[3] as f32, q[0] as f32])
+}
+
+impl Recorder {
+    /// Creates the file `path` for application `app`.
+    ///
+    /// # Errors
+    /// [`VizError::Write`] if the file cannot be created.
+    pub fn create(path: &Path, app: &'static str) -> Result<Self, VizError> {
+        let rec = rerun::RecordingStreamBuilder::new(app)
+            .save(path)
+            .map_err(|e| VizError::Write { path: path.to_owned(), message: e.to_string() })?;
+        rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())
+            .map_err(|e| VizError::Write { path: path.to_owned(), message: e.to_string() })?;
+        Ok(Self { rec, path: path.to_owned(), body_names: Vec::new() })
+    }
+
+    fn err(&self, e: impl std::fmt::Display) -> VizError {
+        VizError::Write { path: self.path.clone(), message: e.to_string() }
+    }
+
+    /// Logs the world's shapes once: terrain geoms under `world/terrain`, robot geoms under
+    /// their bodies. `bodies` names the bodies in model order (body 0 is the world).
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_world(&mut self, shapes: &[GeomShape], bodies: &[BodyPose]) -> Result<(), VizError> {
+        self.body_names = std::iter::once("world".to_owned()).chain(bodies.iter().map(|b| b.name.clone())).collect();
+        for (i, g) in shapes.iter().enumerate() {
+            let name = if g.name.is_empty() { format!("geom_{i}") } else { g.name.clone() };
+            let entity = if g.body == 0 {
+                format!("world/terrain/{name}")
+            } else {
+                let body = self.body_names.get(g.body).cloned().unwrap_or_else(|| format!("body_{}", g.body));
+                format!("world/robot/{body}/{name}")
+            };
+            let color = rgba_u8(g.rgba);
+            let s = g.size;
+            let pose = rerun::Transform3D::from_translation_rotation(v3(g.local_position), quat(g.local_quaternion));
+            self.rec.log_static(entity.as_str(), &pose).map_err(|e| self.err(e))?;
+            let logged = match g.kind {
+                GeomKind::Box => self.rec.log_static(
+                    entity.as_str(),
+                    &rerun::Boxes3D::from_half_sizes([v3(s)]).with_colors([color]).with_fill_mode(rerun::FillMode::Solid),
+                ),
+                GeomKind::Plane => self.rec.log_static(
+                    entity.as_str(),
+                    &rerun::Boxes3D::from_centers_and_half_sizes([[0.0, 0.0, -0.001]], [[s[0] as f32, s[1] as f32, 0.001]])
+                        .with_colors([rerun::Color::from_rgb(200, 200, 190)])
+                        .with_fill_mode(rerun::FillMode::Solid),
+                ),
+                GeomKind::Sphere => self.rec.log_static(
+                    entity.as_str(),
+                    &rerun::Ellipsoids3D::from_radii([s[0] as f32]).with_colors([color]).with_fill_mode(rerun::FillMode::Solid),
+                ),
+                GeomKind::Capsule => self.rec.log_static(
+                    entity.as_str(),
+                    &rerun::Capsules3D::from_endpoints_and_radii(
+                        [[0.0, 0.0, -s[1] as f32]],
+                        [[0.0, 0.0, s[1] as f32]],
+                        [s[0] as f32],
+                    )
+                    .with_colors([color]),
+                ),
+                GeomKind::Cylinder => self.rec.log_static(
+                    entity.as_str(),
+                    &rerun::Cylinders3D::from_lengths_and_radii([2.0 * s[1] as f32], [s[0] as f32])
+                        .with_colors([color])
+                        .with_fill_mode(rerun::FillMode::Solid),
+                ),
+                GeomKind::Mesh => {
+                    let vertices: Vec<[f32; 3]> = g.triangles.iter().flat_map(|t| t.map(v3)).collect();
+                    let indices: Vec<[u32; 3]> = (0..g.triangles.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+                    self.rec.log_static(
+                        entity.as_str(),
+                        &rerun::Mesh3D::new(vertices).with_triangle_indices(indices).with_albedo_factor(albedo(g.rgba)),
+                    )
+                }
+            };
+            logged.map_err(|e| self.err(e))?;
+        }
+        Ok(())
+    }
+
+    /// Logs the bodies' poses at simulated time `time`.
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_bodies(&self, time: f64, bodies: &[BodyPose]) -> Result<(), VizError> {
+        self.rec.set_duration_secs(SIM_TIME, time);
+        for b in bodies {
+            let t = rerun::Transform3D::from_translation_rotation(v3(b.position), quat(b.quaternion));
+            self.rec.log(format!("world/robot/{}", b.name), &t).map_err(|e| self.err(e))?;
+        }
+        Ok(())
+    }
+
+    /// Logs a stability sample: the CoM's ground projection, the support polygon and the
+    /// margin time series.
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_stability(&self, s: &StabilitySample, ground_z: f64) -> Result<(), VizError> {
+        self.rec.set_duration_secs(SIM_TIME, s.time);
+        let z = ground_z as f32 + 0.005;
+        let color = if s.margin > 0.0 { rerun::Color::from_rgb(40, 200, 60) } else { rerun::Color::from_rgb(230, 40, 40) };
+        self.rec
+            .log(
+                "world/stability/com",
+                &rerun::Points3D::new([[s.com[0] as f32, s.com[1] as f32, z], v3(s.com)]).with_radii([0.025]).with_colors([color]),
+            )
+            .map_err(|e| self.err(e))?;
+        let mut ring: Vec<[f32; 3]> = s.support_polygon.iter().map(|p| [p[0] as f32, p[1] as f32, z]).collect();
+        if let Some(first) = ring.first().copied() {
+            ring.push(first);
+        }
+        self.rec
+            .log("world/stability/support_polygon", &rerun::LineStrips3D::new([ring]).with_colors([color]))
+            .map_err(|e| self.err(e))?;
+        if s.margin.is_finite() {
+            self.rec.log("plots/stability_margin_m", &rerun::Scalars::single(s.margin)).map_err(|e| self.err(e))?;
+        }
+        Ok(())
+    }
+
+    /// Logs a scalar time series value under `plots/<name>`.
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_scalar(&self, time: f64, name: &str, value: f64) -> Result<(), VizError> {
+        self.rec.set_duration_secs(SIM_TIME, time);
+        self.rec.log(format!("plots/{name}"), &rerun::Scalars::single(value)).map_err(|e| self.err(e))
+    }
+
+    /// Flushes and closes the file.
+    ///
+    /// # Errors
+    /// [`VizError`] if the final write fails.
+    pub fn finish(self) -> Result<(), VizError> {
+        self.rec.flush_blocking().map_err(|e| self.err(e))
+    }
+}

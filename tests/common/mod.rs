@@ -1,0 +1,28 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use momaro::scenario::Scenario;
+use std::path::PathBuf;
+
+/// Repository root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Loads `scenarios/<name>.toml`.
+pub fn scenario(name: &str) -> Scenario {
+    Scenario::load(&root().join("scenarios").join(format!("{name}.toml"))).expect("scenario loads")
+}
+
+/// The robot model file.
+pub fn model() -> PathBuf {
+    momaro::sim::default_model_path()
+}
+
+/// A fresh temporary directory under the target dir.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
