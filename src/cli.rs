@@ -47,6 +47,25 @@ pub enum Command {
         #[command(flatten)]
         model: ModelArgs,
     },
+    /// Build the height map and the paper's cost layers (foot, body, pose cost) of a scenario.
+    Costmap {
+        /// Scenario file.
+        scenario: PathBuf,
+        /// Write PNG images of the layers into this directory.
+        #[arg(long, value_name = "DIR")]
+        png: Option<PathBuf>,
+        /// Use the height map the robot's laser senses in MuJoCo, not the rasterised one.
+        #[arg(long)]
+        sensed: bool,
+        /// Write a Rerun recording.
+        #[arg(long, value_name = "FILE.rrd")]
+        rerun: Option<PathBuf>,
+        /// Print the summary as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
     /// Write the URDF of the robot, generated from the MJCF model.
     Urdf {
         /// Output file (default: standard output).
@@ -115,6 +134,26 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 }
             }
             Ok(summary.upright && summary.body_collisions.is_empty())
+        }
+        Command::Costmap { scenario, png, sensed, rerun, json, model } => {
+            let sc = load(&scenario)?;
+            let opts = jobs::costmap::CostmapOptions { sensed, png_dir: png, rerun, model_path: model.model };
+            let s = jobs::costmap::run(&sc, &opts).with_context(|| format!("costmap {}", scenario.display()))?;
+            if json {
+                print_json(&s)?;
+            } else {
+                println!("scenario            {} ({} height map)", s.scenario, s.source);
+                println!("map                 {} x {} cells of {} m from ({}, {})", s.cells[0], s.cells[1], s.resolution_m, s.origin[0], s.origin[1]);
+                println!("build time          height map {:.1} ms, cost layers {:.1} ms", s.height_map_time_s * 1e3, s.cost_maps_time_s * 1e3);
+                println!("foot cost cells     {} infinite, {} unknown", s.infinite_foot_cells, s.unknown_foot_cells);
+                if let Some(sensed) = &s.sensed {
+                    println!("laser               {} rays, {} cells seen, max error on flat cells {:.4} m, {} violations", sensed.rays, sensed.seen_cells, sensed.agreement.max_uniform_error_m, sensed.agreement.violations);
+                }
+                for img in &s.images {
+                    println!("wrote               {}", img.display());
+                }
+            }
+            Ok(true)
         }
         Command::Urdf { output, model } => {
             let sim = crate::sim::Simulation::robot_only(&model.model)?;

@@ -4,6 +4,8 @@
 
 pub mod cli;
 pub mod control;
+pub mod cost;
+pub mod cost_image;
 pub mod geometry;
 pub mod jobs;
 pub mod monitor;
@@ -14,5 +16,6 @@ pub mod robot;
 pub mod scenario;
 pub mod sim;
 pub mod stability;
+pub mod terrain;
 pub mod urdf_export;
 pub mod viz;

@@ -2,7 +2,6 @@
 //! posture under a standing controller, optionally driving a constant body twist through
 //! the omnidirectional wheel kinematics, while the stability monitor measures it.
 
-use crate::control::stand::neutral_posture;
 use crate::control::wheels::{Twist, WheelKinematics};
 use crate::geometry::wrap_angle;
 use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor};
@@ -120,12 +119,7 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
     }
     let mut sim = Simulation::new(scenario, &opts.model_path)?;
     let robot = sim.robot().clone();
-    let leg_height = scenario.params.driving_leg_height_m;
-    let posture = neutral_posture(&robot, leg_height)?;
-    let nominal_base_height = leg_height - robot.hips[0][2];
-    let start = scenario.start;
-    let ground = scenario.terrain_height(start.x, start.y);
-    sim.place_robot([start.x, start.y, ground + nominal_base_height], start.theta, &posture);
+    let (posture, nominal_base_height) = super::stand_at_start(&mut sim, scenario)?;
 
     let mut recorder = match &opts.rerun {
         Some(path) => {

@@ -270,22 +270,31 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
         validate_primitive(&format!("terrain[{i}]"), prim)?;
     }
     f.params.validate().map_err(|e| (format!("params.{}", e.name), format!("{} {}", e.value, e.reason)))?;
-    // The base would be inside a solid taller than the clearance under it while driving.
+    // Inside an obstacle: under the base (a disc of the base-circle radius) the terrain
+    // rises above its lowest point by more than the clearance under the base while driving.
+    // Standing on a platform or a landing is fine; a pole under the base is fine if low.
     for (name, p) in [("start", &f.start), ("goal", &f.goal)] {
-        for (i, prim) in f.terrain.iter().enumerate() {
-            if let Some(h) = prim.surface_height(p.x, p.y)
-                && h > f.params.driving_leg_height_m
-            {
-                return Err((
-                    name.into(),
-                    format!(
-                        "({}, {}) lies inside terrain[{i}] ({}, {h:.2} m tall): the robot would start inside an obstacle",
-                        p.x,
-                        p.y,
-                        prim.kind()
-                    ),
-                ));
+        let r = f.params.base_circle_radius_m;
+        let mut samples = vec![(p.x, p.y)];
+        for k in 0..16 {
+            let a = f64::from(k) * std::f64::consts::TAU / 16.0;
+            for rr in [r / 2.0, r] {
+                samples.push((p.x + rr * a.cos(), p.y + rr * a.sin()));
             }
+        }
+        let heights: Vec<f64> = samples.iter().map(|&(x, y)| terrain::terrain_height(&f.terrain, x, y)).collect();
+        let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
+        let (k, hi) = heights.iter().copied().enumerate().fold((0, f64::NEG_INFINITY), |a, (k, h)| if h > a.1 { (k, h) } else { a });
+        if hi - lo > f.params.driving_leg_height_m {
+            let (x, y) = samples[k];
+            let culprit = f.terrain.iter().position(|prim| prim.surface_height(x, y) == Some(hi)).map_or(String::new(), |i| format!(" (terrain[{i}], {})", f.terrain[i].kind()));
+            return Err((
+                name.into(),
+                format!(
+                    "({}, {}): terrain{culprit} rises {:.2} m under the base, more than its {:.2} m clearance: the robot would be inside an obstacle",
+                    p.x, p.y, hi - lo, f.params.driving_leg_height_m
+                ),
+            ));
         }
     }
     let e = &f.expect;
@@ -411,6 +420,12 @@ mod tests {
     fn start_inside_an_obstacle_is_rejected() {
         let text = GOOD.replace("center = [2.0, 1.5]", "center = [0.0, 0.0]").replace("height = 0.2", "height = 0.5");
         assert_eq!(field_of(&text), "start");
+    }
+
+    #[test]
+    fn standing_on_a_platform_is_not_inside_it() {
+        let text = GOOD.replace("center = [2.0, 1.5]", "center = [0.0, 0.0]").replace("size = [0.5, 0.5]", "size = [3.0, 3.0]").replace("height = 0.2", "height = 0.5");
+        parse(&text).unwrap();
     }
 
     #[test]

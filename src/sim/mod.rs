@@ -11,6 +11,7 @@ pub mod world;
 
 use crate::robot::{Leg, RobotDescription};
 use crate::scenario::Scenario;
+use crate::terrain::sensed::{RayCaster, RayHit};
 use mujoco_rs::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -510,30 +511,6 @@ impl Simulation {
             .collect()
     }
 
-    /// Casts rays from `origin` along `directions` against terrain geoms only (group 0),
-    /// never the robot. Each result is the hit distance and surface normal, or `None`.
-    pub fn cast_terrain_rays(
-        &mut self,
-        origin: [f64; 3],
-        directions: &[[f64; 3]],
-        max_range: f64,
-    ) -> Vec<Option<(f64, [f64; 3])>> {
-        let mut groups = [0u8; mujoco_rs::mujoco_c::mjNGROUP as usize];
-        groups[0] = 1;
-        let mut normals = vec![[0.0; 3]; directions.len()];
-        let result =
-            self.data.try_multi_ray(&origin, directions, Some(&groups), true, None, max_range, Some(&mut normals));
-        match result {
-            Ok((ids, dist)) => ids
-                .iter()
-                .zip(dist)
-                .zip(normals)
-                .map(|((id, d), n)| (id.is_some() && d >= 0.0 && d <= max_range).then_some((d, n)))
-                .collect(),
-            Err(_) => vec![None; directions.len()],
-        }
-    }
-
     /// World position of a site of the robot (e.g. `laser`, `imu`).
     ///
     /// # Errors
@@ -560,5 +537,25 @@ impl Simulation {
     /// [`SimError::MissingElement`] if the model lacks an element the export names.
     pub fn urdf_inputs(&self) -> Result<crate::urdf_export::UrdfInputs, SimError> {
         model::urdf_inputs(&self.model)
+    }
+}
+
+/// Range beyond which the laser reports nothing, m (MuJoCo's ray cut-off).
+const LASER_CUTOFF_M: f64 = 30.0;
+
+/// The simulated laser: MuJoCo's `mj_multiRay` against terrain geoms only (group 0), so
+/// the robot never sees itself.
+impl RayCaster for Simulation {
+    fn cast_rays(&mut self, origin: [f64; 3], directions: &[[f64; 3]], hits: &mut Vec<Option<RayHit>>) {
+        hits.clear();
+        let mut groups = [0u8; mujoco_rs::mujoco_c::mjNGROUP as usize];
+        groups[0] = 1;
+        let mut normals = vec![[0.0; 3]; directions.len()];
+        match self.data.try_multi_ray(&origin, directions, Some(&groups), true, None, LASER_CUTOFF_M, Some(&mut normals)) {
+            Ok((ids, dist)) => hits.extend(ids.iter().zip(dist).zip(normals).map(|((id, distance), normal)| {
+                (id.is_some() && distance >= 0.0).then_some(RayHit { distance, normal })
+            })),
+            Err(_) => hits.extend(std::iter::repeat_n(None, directions.len())),
+        }
     }
 }

@@ -7,7 +7,9 @@
 //! - `plots/stability_margin_m`: the margin as a time series;
 //! - `world/plan/...` and `maps/...`: plans and cost layers, where a job logs them.
 
+use crate::cost_image::RgbImage;
 use crate::monitor::StabilitySample;
+use crate::terrain::HeightMap;
 use crate::sim::{BodyPose, GeomKind, GeomShape};
 use std::path::{Path, PathBuf};
 
@@ -187,6 +189,52 @@ impl Recorder {
     pub fn log_scalar(&self, time: f64, name: &str, value: f64) -> Result<(), VizError> {
         self.rec.set_duration_secs(SIM_TIME, time);
         self.rec.log(format!("plots/{name}"), &rerun::Scalars::single(value)).map_err(|e| self.err(e))
+    }
+
+    /// Logs the known cells of a height map as a static point cloud under
+    /// `world/height_map`, coloured from low (blue) to high (orange).
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_height_map(&self, map: &HeightMap) -> Result<(), VizError> {
+        let (nx, ny) = map.dims();
+        let mut points = Vec::new();
+        let mut heights = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                if let Some(h) = map.get(i, j) {
+                    let c = map.cell_center(i, j);
+                    points.push([c[0] as f32, c[1] as f32, h as f32]);
+                    heights.push(h);
+                }
+            }
+        }
+        let (lo, hi) = heights.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &h| (a.min(h), b.max(h)));
+        let span = if hi > lo { hi - lo } else { 1.0 };
+        let colors: Vec<rerun::Color> = heights
+            .iter()
+            .map(|h| {
+                let t = ((h - lo) / span) as f32;
+                rerun::Color::from_rgb((40.0 + 200.0 * t) as u8, (90.0 + 60.0 * t) as u8, (200.0 - 170.0 * t) as u8)
+            })
+            .collect();
+        let radius = (map.resolution() / 2.0) as f32;
+        self.rec
+            .log_static("world/height_map", &rerun::Points3D::new(points).with_colors(colors).with_radii([radius]))
+            .map_err(|e| self.err(e))
+    }
+
+    /// Logs a rendered map layer as a static image under `maps/<name>` (+y up, one pixel per
+    /// cell; `origin` and `resolution` are recorded as text beside it).
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_layer_image(&self, name: &str, image: &RgbImage, origin: [f64; 2], resolution: f64) -> Result<(), VizError> {
+        self.rec
+            .log_static(format!("maps/{name}"), &rerun::Image::from_rgb24(image.pixels.clone(), [image.width, image.height]))
+            .map_err(|e| self.err(e))?;
+        let text = format!("{name}: {} x {} cells of {resolution} m, cell (0, 0) at ({}, {}), +y up", image.width, image.height, origin[0], origin[1]);
+        self.rec.log_static(format!("maps/{name}/info"), &rerun::TextDocument::new(text)).map_err(|e| self.err(e))
     }
 
     /// Flushes and closes the file.

@@ -1,0 +1,530 @@
+//! The 2.5D height map: a regular grid of terrain heights, `NaN` where unknown.
+//!
+//! This is the one place that defines the grid convention used by every layer built on
+//! it (foot cost, body cost, images):
+//!
+//! - Cell `(i, j)` covers `[origin_x + i·res, origin_x + (i+1)·res)` in x and
+//!   `[origin_y + j·res, origin_y + (j+1)·res)` in y (half-open, so every point belongs to
+//!   exactly one cell). `i` runs along +x (`0..nx`), `j` along +y (`0..ny`).
+//! - Storage is row-major with rows of constant y: the value of cell `(i, j)` lives at
+//!   index `j·nx + i`, so x is the contiguous direction.
+//! - A cell's value is a terrain height in metres (z up, world frame) or `NaN` for
+//!   "unknown" (never observed). Infinite values are rejected: a height is finite or
+//!   unknown.
+//! - The cell *centre* `(origin_x + (i+½)·res, origin_y + (j+½)·res)` is the point a cell
+//!   stands for in distance computations (foot and body costs).
+//!
+//! What a cell's height means depends on the source: see `rasterise` (highest surface
+//! over the cell's area) and `sensed` (highest up-facing laser return in the cell).
+
+/// Why a height map (or a view of one) could not be made or changed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HeightMapError {
+    /// The cell size is not a finite number > 0.
+    #[error("height map resolution must be a finite number > 0 m, got {0}")]
+    BadResolution(f64),
+    /// A dimension is zero (or the cell count overflows).
+    #[error("height map must have at least one cell, got {nx} x {ny}")]
+    Empty {
+        /// Cells along x.
+        nx: usize,
+        /// Cells along y.
+        ny: usize,
+    },
+    /// The origin is not finite.
+    #[error("height map origin must be finite, got ({x}, {y})")]
+    BadOrigin {
+        /// Origin x, m.
+        x: f64,
+        /// Origin y, m.
+        y: f64,
+    },
+    /// The data vector does not hold `nx · ny` values.
+    #[error("height map data holds {got} values, expected {nx} x {ny} = {}", nx * ny)]
+    SizeMismatch {
+        /// Cells along x.
+        nx: usize,
+        /// Cells along y.
+        ny: usize,
+        /// Values supplied.
+        got: usize,
+    },
+    /// A height is ±∞ (unknown must be written as NaN).
+    #[error("cell ({i}, {j}) holds {value}: a height must be finite, or NaN for unknown")]
+    InfiniteHeight {
+        /// Cell index along x.
+        i: usize,
+        /// Cell index along y.
+        j: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// A cell index or a view lies (partly) outside the map.
+    #[error("cells [{i0}, {i0}+{ni}) x [{j0}, {j0}+{nj}) are not inside the {nx} x {ny} map")]
+    OutOfBounds {
+        /// First index along x.
+        i0: usize,
+        /// First index along y.
+        j0: usize,
+        /// Count along x.
+        ni: usize,
+        /// Count along y.
+        nj: usize,
+        /// Map cells along x.
+        nx: usize,
+        /// Map cells along y.
+        ny: usize,
+    },
+}
+
+/// A regular grid of terrain heights (m), `NaN` = unknown. See the module doc for the
+/// frame convention.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeightMap {
+    origin: [f64; 2],
+    resolution: f64,
+    nx: usize,
+    ny: usize,
+    data: Vec<f64>,
+}
+
+fn check_geometry(
+    origin: [f64; 2],
+    resolution: f64,
+    nx: usize,
+    ny: usize,
+) -> Result<(), HeightMapError> {
+    if !(resolution.is_finite() && resolution > 0.0) {
+        return Err(HeightMapError::BadResolution(resolution));
+    }
+    if !(origin[0].is_finite() && origin[1].is_finite()) {
+        return Err(HeightMapError::BadOrigin { x: origin[0], y: origin[1] });
+    }
+    if nx == 0 || ny == 0 || nx.checked_mul(ny).is_none() {
+        return Err(HeightMapError::Empty { nx, ny });
+    }
+    Ok(())
+}
+
+impl HeightMap {
+    /// A map from row-major data (`data[j·nx + i]` is cell `(i, j)`).
+    ///
+    /// # Errors
+    /// Bad resolution or origin, zero cells, a data length other than `nx · ny`, or an
+    /// infinite height.
+    pub fn new(
+        origin: [f64; 2],
+        resolution: f64,
+        nx: usize,
+        ny: usize,
+        data: Vec<f64>,
+    ) -> Result<Self, HeightMapError> {
+        check_geometry(origin, resolution, nx, ny)?;
+        if data.len() != nx * ny {
+            return Err(HeightMapError::SizeMismatch { nx, ny, got: data.len() });
+        }
+        if let Some(k) = data.iter().position(|v| v.is_infinite()) {
+            return Err(HeightMapError::InfiniteHeight { i: k % nx, j: k / nx, value: data[k] });
+        }
+        Ok(Self { origin, resolution, nx, ny, data })
+    }
+
+    /// A map with every cell at `value` (`NaN` for an all-unknown map).
+    ///
+    /// # Errors
+    /// As [`HeightMap::new`].
+    pub fn filled(
+        origin: [f64; 2],
+        resolution: f64,
+        nx: usize,
+        ny: usize,
+        value: f64,
+    ) -> Result<Self, HeightMapError> {
+        check_geometry(origin, resolution, nx, ny)?;
+        if value.is_infinite() {
+            return Err(HeightMapError::InfiniteHeight { i: 0, j: 0, value });
+        }
+        Ok(Self { origin, resolution, nx, ny, data: vec![value; nx * ny] })
+    }
+
+    /// A map with every cell unknown.
+    ///
+    /// # Errors
+    /// As [`HeightMap::new`].
+    pub fn unknown(
+        origin: [f64; 2],
+        resolution: f64,
+        nx: usize,
+        ny: usize,
+    ) -> Result<Self, HeightMapError> {
+        Self::filled(origin, resolution, nx, ny, f64::NAN)
+    }
+
+    /// A map whose cell `(i, j)` holds `f(i, j)`.
+    ///
+    /// # Errors
+    /// As [`HeightMap::new`].
+    pub fn from_fn(
+        origin: [f64; 2],
+        resolution: f64,
+        nx: usize,
+        ny: usize,
+        mut f: impl FnMut(usize, usize) -> f64,
+    ) -> Result<Self, HeightMapError> {
+        check_geometry(origin, resolution, nx, ny)?;
+        let mut data = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                data.push(f(i, j));
+            }
+        }
+        Self::new(origin, resolution, nx, ny, data)
+    }
+
+    /// `(nx, ny)`: cells along x and along y.
+    pub fn dims(&self) -> (usize, usize) {
+        (self.nx, self.ny)
+    }
+
+    /// Cells along x.
+    pub fn nx(&self) -> usize {
+        self.nx
+    }
+
+    /// Cells along y.
+    pub fn ny(&self) -> usize {
+        self.ny
+    }
+
+    /// Total number of cells.
+    pub fn len(&self) -> usize {
+        self.data.len()
+    }
+
+    /// Always false: a map has at least one cell.
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// World position (x, y) of the corner of cell (0, 0), m.
+    pub fn origin(&self) -> [f64; 2] {
+        self.origin
+    }
+
+    /// Cell edge length, m.
+    pub fn resolution(&self) -> f64 {
+        self.resolution
+    }
+
+    /// World extent `[x_min, y_min, x_max, y_max]` covered by the cells, m.
+    pub fn bounds(&self) -> [f64; 4] {
+        [
+            self.origin[0],
+            self.origin[1],
+            self.origin[0] + self.nx as f64 * self.resolution,
+            self.origin[1] + self.ny as f64 * self.resolution,
+        ]
+    }
+
+    /// The cell containing world point (x, y), or `None` outside the map (or for NaN).
+    #[inline]
+    pub fn cell_of(&self, x: f64, y: f64) -> Option<(usize, usize)> {
+        let fx = (x - self.origin[0]) / self.resolution;
+        let fy = (y - self.origin[1]) / self.resolution;
+        // The comparisons are false for NaN, so NaN input yields None. On [0, n) the
+        // truncating cast is floor (and cheaper: no libm call on baseline x86-64).
+        if fx >= 0.0 && fy >= 0.0 && fx < self.nx as f64 && fy < self.ny as f64 {
+            Some((fx as usize, fy as usize))
+        } else {
+            None
+        }
+    }
+
+    /// World position of the centre of cell (i, j), m. Defined for any index, also
+    /// outside the map.
+    #[inline]
+    pub fn cell_center(&self, i: usize, j: usize) -> [f64; 2] {
+        [
+            self.origin[0] + (i as f64 + 0.5) * self.resolution,
+            self.origin[1] + (j as f64 + 0.5) * self.resolution,
+        ]
+    }
+
+    /// Row-major index of cell (i, j), or `None` outside the map.
+    #[inline]
+    pub fn index(&self, i: usize, j: usize) -> Option<usize> {
+        (i < self.nx && j < self.ny).then(|| j * self.nx + i)
+    }
+
+    /// Known height of cell (i, j); `None` if the cell is unknown or outside the map.
+    #[inline]
+    pub fn get(&self, i: usize, j: usize) -> Option<f64> {
+        let v = self.raw(i, j);
+        (!v.is_nan()).then_some(v)
+    }
+
+    /// Stored value of cell (i, j): the height, or `NaN` if unknown or outside the map.
+    #[inline]
+    pub fn raw(&self, i: usize, j: usize) -> f64 {
+        match self.index(i, j) {
+            Some(k) => self.data[k],
+            None => f64::NAN,
+        }
+    }
+
+    /// Whether cell (i, j) lies in the map and has a known height.
+    pub fn is_known(&self, i: usize, j: usize) -> bool {
+        self.get(i, j).is_some()
+    }
+
+    /// Sets cell (i, j) to `value` (a finite height, or `NaN` to mark it unknown).
+    ///
+    /// # Errors
+    /// The cell is outside the map, or `value` is infinite.
+    pub fn set(&mut self, i: usize, j: usize, value: f64) -> Result<(), HeightMapError> {
+        if value.is_infinite() {
+            return Err(HeightMapError::InfiniteHeight { i, j, value });
+        }
+        let k = self.index(i, j).ok_or(HeightMapError::OutOfBounds {
+            i0: i,
+            j0: j,
+            ni: 1,
+            nj: 1,
+            nx: self.nx,
+            ny: self.ny,
+        })?;
+        self.data[k] = value;
+        Ok(())
+    }
+
+    /// Height of the cell containing (x, y): `None` if unknown or outside the map.
+    #[inline]
+    pub fn height_at_cell(&self, x: f64, y: f64) -> Option<f64> {
+        let (i, j) = self.cell_of(x, y)?;
+        self.get(i, j)
+    }
+
+    /// Bilinear interpolation between the four cell centres around (x, y).
+    ///
+    /// `None` if a needed corner is unknown or outside the map; a corner whose weight is
+    /// exactly zero is not needed (so sampling exactly at a border cell's centre works).
+    pub fn bilinear(&self, x: f64, y: f64) -> Option<f64> {
+        let fx = (x - self.origin[0]) / self.resolution - 0.5;
+        let fy = (y - self.origin[1]) / self.resolution - 0.5;
+        if !(fx.is_finite() && fy.is_finite()) {
+            return None;
+        }
+        let (i0, j0) = (fx.floor(), fy.floor());
+        let (tx, ty) = (fx - i0, fy - j0);
+        let mut sum = 0.0;
+        for (di, wx) in [(0.0, 1.0 - tx), (1.0, tx)] {
+            for (dj, wy) in [(0.0, 1.0 - ty), (1.0, ty)] {
+                let w = wx * wy;
+                if w == 0.0 {
+                    continue;
+                }
+                let (ci, cj) = (i0 + di, j0 + dj);
+                if ci < 0.0 || cj < 0.0 {
+                    return None;
+                }
+                sum += w * self.get(ci as usize, cj as usize)?;
+            }
+        }
+        Some(sum)
+    }
+
+    /// The raw row-major values (`NaN` = unknown), `j·nx + i` for cell (i, j).
+    pub fn as_slice(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// Number of cells with a known height.
+    pub fn known_count(&self) -> usize {
+        self.data.iter().filter(|v| !v.is_nan()).count()
+    }
+
+    /// A borrowed view of the `ni × nj` cells starting at cell `(i0, j0)`.
+    ///
+    /// # Errors
+    /// The view is empty or reaches outside the map.
+    pub fn view(
+        &self,
+        i0: usize,
+        j0: usize,
+        ni: usize,
+        nj: usize,
+    ) -> Result<HeightMapView<'_>, HeightMapError> {
+        let fits = ni > 0
+            && nj > 0
+            && i0.checked_add(ni).is_some_and(|e| e <= self.nx)
+            && j0.checked_add(nj).is_some_and(|e| e <= self.ny);
+        if !fits {
+            return Err(HeightMapError::OutOfBounds { i0, j0, ni, nj, nx: self.nx, ny: self.ny });
+        }
+        Ok(HeightMapView { map: self, i0, j0, ni, nj })
+    }
+}
+
+/// A rectangular window onto a [`HeightMap`]; local cell `(0, 0)` is the map's
+/// `(i0, j0)`. World coordinates are unchanged.
+#[derive(Debug, Clone, Copy)]
+pub struct HeightMapView<'a> {
+    map: &'a HeightMap,
+    i0: usize,
+    j0: usize,
+    ni: usize,
+    nj: usize,
+}
+
+impl<'a> HeightMapView<'a> {
+    /// `(ni, nj)`: cells along x and y.
+    pub fn dims(&self) -> (usize, usize) {
+        (self.ni, self.nj)
+    }
+
+    /// The map cell that local cell (0, 0) is.
+    pub fn offset(&self) -> (usize, usize) {
+        (self.i0, self.j0)
+    }
+
+    /// World position of the corner of local cell (0, 0), m.
+    pub fn origin(&self) -> [f64; 2] {
+        let o = self.map.origin();
+        let r = self.map.resolution();
+        [o[0] + self.i0 as f64 * r, o[1] + self.j0 as f64 * r]
+    }
+
+    /// Cell edge length, m.
+    pub fn resolution(&self) -> f64 {
+        self.map.resolution()
+    }
+
+    /// Known height of local cell (i, j); `None` if unknown or outside the view.
+    pub fn get(&self, i: usize, j: usize) -> Option<f64> {
+        if i < self.ni && j < self.nj { self.map.get(self.i0 + i, self.j0 + j) } else { None }
+    }
+
+    /// Local row `j` as a slice of raw values (`NaN` = unknown), or `None` past the view.
+    pub fn row(&self, j: usize) -> Option<&'a [f64]> {
+        if j >= self.nj {
+            return None;
+        }
+        let start = (self.j0 + j) * self.map.nx() + self.i0;
+        self.map.as_slice().get(start..start + self.ni)
+    }
+
+    /// The map this view borrows from.
+    pub fn map(&self) -> &'a HeightMap {
+        self.map
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp_map() -> HeightMap {
+        // 4 x 3 cells of 0.5 m from (-1, 2); h = i + 10 j.
+        HeightMap::from_fn([-1.0, 2.0], 0.5, 4, 3, |i, j| i as f64 + 10.0 * j as f64).unwrap()
+    }
+
+    #[test]
+    fn construction_errors() {
+        assert_eq!(
+            HeightMap::filled([0.0, 0.0], 0.0, 2, 2, 0.0),
+            Err(HeightMapError::BadResolution(0.0))
+        );
+        assert!(matches!(
+            HeightMap::filled([0.0, 0.0], -0.1, 2, 2, 0.0),
+            Err(HeightMapError::BadResolution(_))
+        ));
+        assert!(matches!(
+            HeightMap::filled([0.0, 0.0], f64::NAN, 2, 2, 0.0),
+            Err(HeightMapError::BadResolution(_))
+        ));
+        assert_eq!(
+            HeightMap::filled([0.0, 0.0], 0.1, 0, 2, 0.0),
+            Err(HeightMapError::Empty { nx: 0, ny: 2 })
+        );
+        assert!(matches!(
+            HeightMap::filled([f64::NAN, 0.0], 0.1, 2, 2, 0.0),
+            Err(HeightMapError::BadOrigin { .. })
+        ));
+        assert_eq!(
+            HeightMap::new([0.0, 0.0], 0.1, 2, 2, vec![0.0; 3]),
+            Err(HeightMapError::SizeMismatch { nx: 2, ny: 2, got: 3 })
+        );
+        assert_eq!(
+            HeightMap::new([0.0, 0.0], 0.1, 2, 2, vec![0.0, 0.0, f64::INFINITY, 0.0]),
+            Err(HeightMapError::InfiniteHeight { i: 0, j: 1, value: f64::INFINITY })
+        );
+        assert!(HeightMap::unknown([0.0, 0.0], 0.1, 2, 2).is_ok());
+    }
+
+    #[test]
+    fn cell_convention_is_half_open_and_row_major() {
+        let m = ramp_map();
+        assert_eq!(m.dims(), (4, 3));
+        assert_eq!(m.cell_of(-1.0, 2.0), Some((0, 0)));
+        assert_eq!(m.cell_of(-0.5, 2.0), Some((1, 0)), "right edge belongs to the next cell");
+        assert_eq!(m.cell_of(-0.500001, 2.49), Some((0, 0)));
+        assert_eq!(m.cell_of(0.99, 3.49), Some((3, 2)));
+        assert_eq!(m.cell_of(1.0, 3.0), None, "x_max is outside");
+        assert_eq!(m.cell_of(-1.0, 3.5), None, "y_max is outside");
+        assert_eq!(m.cell_of(-1.0001, 2.0), None);
+        assert_eq!(m.cell_of(f64::NAN, 2.0), None);
+        assert_eq!(m.cell_center(2, 1), [0.25, 2.75]);
+        assert_eq!(m.as_slice()[4 + 2], 12.0, "cell (2, 1) at j*nx + i");
+        assert_eq!(m.get(2, 1), Some(12.0));
+        assert_eq!(m.get(4, 0), None);
+        assert_eq!(m.height_at_cell(0.3, 3.2), Some(22.0));
+        assert_eq!(m.bounds(), [-1.0, 2.0, 1.0, 3.5]);
+    }
+
+    #[test]
+    fn unknown_cells_and_set() {
+        let mut m = ramp_map();
+        m.set(1, 1, f64::NAN).unwrap();
+        assert_eq!(m.get(1, 1), None);
+        assert!(m.raw(1, 1).is_nan());
+        assert!(!m.is_known(1, 1));
+        assert_eq!(m.known_count(), 11);
+        assert!(matches!(m.set(9, 0, 1.0), Err(HeightMapError::OutOfBounds { .. })));
+        assert!(matches!(
+            m.set(0, 0, f64::NEG_INFINITY),
+            Err(HeightMapError::InfiniteHeight { .. })
+        ));
+    }
+
+    #[test]
+    fn bilinear_interpolates_and_respects_unknown() {
+        let mut m = ramp_map();
+        // Halfway between centres of (0,0) [-0.75, 2.25] and (1,1) [-0.25, 2.75].
+        let v = m.bilinear(-0.5, 2.5).unwrap();
+        assert!((v - (0.5 + 5.0)).abs() < 1e-12, "{v}");
+        // Exactly at a border cell centre: only that corner is needed.
+        assert_eq!(m.bilinear(-0.75, 2.25), Some(0.0));
+        assert_eq!(m.bilinear(0.75, 3.25), Some(23.0));
+        // Beyond the outermost centres: a needed corner is outside.
+        assert_eq!(m.bilinear(-0.9, 2.5), None);
+        m.set(1, 1, f64::NAN).unwrap();
+        assert_eq!(m.bilinear(-0.5, 2.5), None);
+        // Unknown corner with zero weight is not needed.
+        assert_eq!(m.bilinear(-0.75, 2.5), Some(5.0));
+    }
+
+    #[test]
+    fn view_borrows_a_window() {
+        let m = ramp_map();
+        let v = m.view(1, 1, 3, 2).unwrap();
+        assert_eq!(v.dims(), (3, 2));
+        assert_eq!(v.get(0, 0), Some(11.0));
+        assert_eq!(v.get(2, 1), Some(23.0));
+        assert_eq!(v.get(3, 0), None);
+        assert_eq!(v.row(1), Some(&[21.0, 22.0, 23.0][..]));
+        assert_eq!(v.origin(), [-0.5, 2.5]);
+        assert!(m.view(2, 0, 3, 1).is_err());
+        assert!(m.view(0, 0, 0, 1).is_err());
+        assert!(m.view(usize::MAX, 0, 2, 1).is_err());
+    }
+}

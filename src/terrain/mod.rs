@@ -1,0 +1,14 @@
+//! Terrain as the planner sees it: the 2.5D [`HeightMap`] (2.5 cm cells, `NaN` = unknown)
+//! and its two sources, exact rasterisation of scenario primitives ([`rasterise`]) and
+//! ray-cast sensing like the robot's rotating laser ([`sensed`]).
+//!
+//! The cost maps (`cost`) are computed from a `HeightMap` and do not care which source
+//! made it. The grid convention is defined once, in [`heightmap`].
+
+pub mod heightmap;
+pub mod rasterise;
+pub mod sensed;
+
+pub use heightmap::{HeightMap, HeightMapError, HeightMapView};
+pub use rasterise::{RasteriseError, rasterise, rasterise_into};
+pub use sensed::{LaserScanner, RayCaster, RayHit, ScanStats, SensedError};
