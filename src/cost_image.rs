@@ -106,7 +106,12 @@ pub struct RgbImage {
 
 /// A row-major cost layer (`nx × ny`) in the module's colours, `max_cost` at the top of the
 /// scale (with `None`, the largest finite value); `None` if the layer is not `nx × ny`.
-pub fn cost_layer_image(costs: &[Cost], nx: usize, ny: usize, max_cost: Option<f64>) -> Option<RgbImage> {
+pub fn cost_layer_image(
+    costs: &[Cost],
+    nx: usize,
+    ny: usize,
+    max_cost: Option<f64>,
+) -> Option<RgbImage> {
     let top =
         max_cost.unwrap_or_else(|| costs.iter().filter_map(|c| c.finite()).fold(1.0, f64::max));
     render(nx, ny, costs.len(), |k| cost_colour(costs[k], top))

@@ -103,7 +103,8 @@ impl StabilityMonitor {
     /// Measures the simulation's current state without recording it.
     pub fn measure(sim: &Simulation) -> StabilitySample {
         let com = sim.center_of_mass();
-        let contacts: Vec<[f64; 2]> = sim.wheel_contacts().iter().map(|c| [c.position[0], c.position[1]]).collect();
+        let contacts: Vec<[f64; 2]> =
+            sim.wheel_contacts().iter().map(|c| [c.position[0], c.position[1]]).collect();
         let rpy = sim.base().rpy;
         StabilitySample {
             time: sim.time(),
@@ -136,12 +137,14 @@ impl StabilityMonitor {
         self.tipped = tipping;
         let lost = s.contacts.len() < self.limits.expected_wheels;
         if lost && !self.contact_lost {
-            self.events.push(MonitorEvent::ContactLost { time_s: s.time, wheels: s.contacts.len() });
+            self.events
+                .push(MonitorEvent::ContactLost { time_s: s.time, wheels: s.contacts.len() });
         }
         self.contact_lost = lost;
         for body in &s.body_collisions {
             if !self.colliding.contains(body) {
-                self.events.push(MonitorEvent::BodyCollision { time_s: s.time, body: body.clone() });
+                self.events
+                    .push(MonitorEvent::BodyCollision { time_s: s.time, body: body.clone() });
             }
         }
         self.colliding.clone_from(&s.body_collisions);

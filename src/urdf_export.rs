@@ -6,7 +6,10 @@
 //! `<leg>_steer` (steer) → `<leg>_wheel_l` / `<leg>_wheel_r`.
 
 use crate::robot::{Leg, RobotDescription};
-use urdf_rs::{Axis, Geometry, Inertia, Inertial, Joint, JointLimit, JointType, Link, LinkName, Mass, Pose, Robot, Vec3, Visual};
+use urdf_rs::{
+    Axis, Geometry, Inertia, Inertial, Joint, JointLimit, JointType, Link, LinkName, Mass, Pose,
+    Robot, Vec3, Visual,
+};
 
 /// What the URDF needs beyond the kinematic description: per-body masses and the actuators'
 /// limits, read from the compiled model.
@@ -51,7 +54,15 @@ fn link(name: &str, mass: f64, visual: Option<(Geometry, [f64; 3])>) -> Link {
     }
 }
 
-fn joint(name: &str, kind: JointType, parent: &str, child: &str, xyz: [f64; 3], axis: [f64; 3], limit: JointLimit) -> Joint {
+fn joint(
+    name: &str,
+    kind: JointType,
+    parent: &str,
+    child: &str,
+    xyz: [f64; 3],
+    axis: [f64; 3],
+    limit: JointLimit,
+) -> Joint {
     Joint {
         name: name.to_owned(),
         joint_type: kind,
@@ -81,7 +92,8 @@ pub fn momaro_urdf(inp: &UrdfInputs) -> Robot {
     let y = [0.0, 1.0, 0.0];
     for leg in Leg::ALL {
         let p = leg.prefix();
-        let names = [format!("{p}_thigh"), format!("{p}_shin"), format!("{p}_foot"), format!("{p}_steer")];
+        let names =
+            [format!("{p}_thigh"), format!("{p}_shin"), format!("{p}_foot"), format!("{p}_steer")];
         let lengths = [r.thigh_length, r.shin_length, r.foot_length];
         for (k, len) in lengths.iter().enumerate() {
             links.push(link(
@@ -92,7 +104,12 @@ pub fn momaro_urdf(inp: &UrdfInputs) -> Robot {
         }
         links.push(link(&names[3], lookup(&inp.body_masses, &names[3]), None));
         let parents = ["base".to_owned(), names[0].clone(), names[1].clone(), names[2].clone()];
-        let origins = [r.hips[leg.index()], [0.0, 0.0, -r.thigh_length], [0.0, 0.0, -r.shin_length], [0.0, 0.0, -r.foot_length]];
+        let origins = [
+            r.hips[leg.index()],
+            [0.0, 0.0, -r.thigh_length],
+            [0.0, 0.0, -r.shin_length],
+            [0.0, 0.0, -r.foot_length],
+        ];
         for (k, jn) in ["hip", "knee", "ankle"].iter().enumerate() {
             let name = format!("{p}_{jn}");
             let range = r.joint_ranges[k];
@@ -102,7 +119,15 @@ pub fn momaro_urdf(inp: &UrdfInputs) -> Robot {
                 effort: lookup(&inp.effort_limits, &name),
                 velocity: lookup(&inp.velocity_limits, &name),
             };
-            joints.push(joint(&name, JointType::Revolute, &parents[k], &names[k], origins[k], y, limit));
+            joints.push(joint(
+                &name,
+                JointType::Revolute,
+                &parents[k],
+                &names[k],
+                origins[k],
+                y,
+                limit,
+            ));
         }
         let steer = format!("{p}_steer");
         let limit = JointLimit {
@@ -111,7 +136,15 @@ pub fn momaro_urdf(inp: &UrdfInputs) -> Robot {
             effort: lookup(&inp.effort_limits, &steer),
             velocity: lookup(&inp.velocity_limits, &steer),
         };
-        joints.push(joint(&steer, JointType::Revolute, &parents[3], &names[3], origins[3], [0.0, 0.0, 1.0], limit));
+        joints.push(joint(
+            &steer,
+            JointType::Revolute,
+            &parents[3],
+            &names[3],
+            origins[3],
+            [0.0, 0.0, 1.0],
+            limit,
+        ));
         for (side, sign) in [("l", 1.0), ("r", -1.0)] {
             let wheel = format!("{p}_wheel_{side}");
             links.push(link(
@@ -125,7 +158,15 @@ pub fn momaro_urdf(inp: &UrdfInputs) -> Robot {
                 effort: lookup(&inp.effort_limits, &wheel),
                 velocity: lookup(&inp.velocity_limits, &wheel),
             };
-            joints.push(joint(&wheel, JointType::Continuous, &names[3], &wheel, [0.0, sign * r.wheel_track / 2.0, 0.0], y, limit));
+            joints.push(joint(
+                &wheel,
+                JointType::Continuous,
+                &names[3],
+                &wheel,
+                [0.0, sign * r.wheel_track / 2.0, 0.0],
+                y,
+                limit,
+            ));
         }
     }
     Robot { name: "momaro".to_owned(), links, joints, materials: Vec::new() }

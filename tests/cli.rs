@@ -35,9 +35,17 @@ fn expect_bad_input(name: &str, text: &str, must_mention: &[&str]) {
     std::fs::write(&path, text).unwrap();
     let out = momaro(&["sim", path.to_str().unwrap(), "--duration", "0.1"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{name}: exit {:?}, stderr: {stderr}", out.status.code());
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{name}: exit {:?}, stderr: {stderr}",
+        out.status.code()
+    );
     assert!(!stderr.contains("panicked"), "{name}: panicked: {stderr}");
-    assert!(stderr.contains(&format!("{name}.toml")), "{name}: error does not name the file: {stderr}");
+    assert!(
+        stderr.contains(&format!("{name}.toml")),
+        "{name}: error does not name the file: {stderr}"
+    );
     for m in must_mention {
         assert!(stderr.contains(m), "{name}: error does not mention `{m}`: {stderr}");
     }
@@ -68,29 +76,50 @@ fn unknown_key() {
 
 #[test]
 fn negative_size() {
-    expect_bad_input("negative_size", &GOOD.replace("size = [0.4, 0.4]", "size = [0.4, -0.4]"), &["terrain[0].size"]);
+    expect_bad_input(
+        "negative_size",
+        &GOOD.replace("size = [0.4, 0.4]", "size = [0.4, -0.4]"),
+        &["terrain[0].size"],
+    );
 }
 
 #[test]
 fn goal_outside_the_map() {
-    expect_bad_input("goal_outside", &GOOD.replace("x = 2.0", "x = 20.0"), &["goal", "outside the map"]);
+    expect_bad_input(
+        "goal_outside",
+        &GOOD.replace("x = 2.0", "x = 20.0"),
+        &["goal", "outside the map"],
+    );
 }
 
 #[test]
 fn nan_value() {
-    expect_bad_input("nan_value", &GOOD.replace("height = 0.2", "height = nan"), &["terrain[0].height"]);
+    expect_bad_input(
+        "nan_value",
+        &GOOD.replace("height = 0.2", "height = nan"),
+        &["terrain[0].height"],
+    );
 }
 
 #[test]
 fn start_inside_an_obstacle() {
-    let text = GOOD.replace("center = [1.0, 1.5]", "center = [0.0, 0.0]").replace("height = 0.2", "height = 0.6");
+    let text = GOOD
+        .replace("center = [1.0, 1.5]", "center = [0.0, 0.0]")
+        .replace("height = 0.2", "height = 0.6");
     expect_bad_input("start_inside", &text, &["start", "inside"]);
 }
 
 #[test]
 fn missing_model_file() {
     let scenario = common::root().join("scenarios/flat.toml");
-    let out = momaro(&["sim", scenario.to_str().unwrap(), "--model", "/no/such/momaro.xml", "--duration", "0.1"]);
+    let out = momaro(&[
+        "sim",
+        scenario.to_str().unwrap(),
+        "--model",
+        "/no/such/momaro.xml",
+        "--duration",
+        "0.1",
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("/no/such/momaro.xml") && !stderr.contains("panicked"), "{stderr}");
@@ -138,10 +167,25 @@ fn recording_verifies_with_rerun() {
     let dir = common::temp_dir("rrd");
     let rrd = dir.join("flat.rrd");
     let scenario = common::root().join("scenarios/flat.toml");
-    let out = momaro(&["sim", scenario.to_str().unwrap(), "--duration", "1", "--drive", "0.3,0,0.2", "--rerun", rrd.to_str().unwrap()]);
+    let out = momaro(&[
+        "sim",
+        scenario.to_str().unwrap(),
+        "--duration",
+        "1",
+        "--drive",
+        "0.3,0,0.2",
+        "--rerun",
+        rrd.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(Path::new(&rrd).metadata().map(|m| m.len() > 1000).unwrap_or(false), "recording is empty");
-    let verify = Command::new(&rerun).args(["rrd", "verify", rrd.to_str().unwrap()]).output().expect("rerun runs");
+    assert!(
+        Path::new(&rrd).metadata().map(|m| m.len() > 1000).unwrap_or(false),
+        "recording is empty"
+    );
+    let verify = Command::new(&rerun)
+        .args(["rrd", "verify", rrd.to_str().unwrap()])
+        .output()
+        .expect("rerun runs");
     assert!(
         verify.status.success(),
         "rerun rrd verify failed: {}{}",

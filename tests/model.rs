@@ -11,7 +11,8 @@ use momaro::sim::Simulation;
 fn model_derived_kinematics_match_mujoco_forward_kinematics() {
     let mut sim = Simulation::robot_only(&common::model()).expect("model compiles");
     let robot = sim.robot().clone();
-    let configs: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [1.3, -2.5, 1.2], [-0.4, 0.9, -0.5], [0.7, -1.4, 0.7]];
+    let configs: [[f64; 3]; 4] =
+        [[0.0, 0.0, 0.0], [1.3, -2.5, 1.2], [-0.4, 0.9, -0.5], [0.7, -1.4, 0.7]];
     for q in configs {
         sim.place_robot([0.0, 0.0, 1.5], 0.0, &[q; 4]);
         let base = sim.base().position;
@@ -24,8 +25,18 @@ fn model_derived_kinematics_match_mujoco_forward_kinematics() {
             let axle = [contact[0], contact[1] + robot.wheel_radius];
             let got = centres[leg.index()];
             let expected = [base[0] + hip[0] + axle[0], base[2] + hip[2] + axle[1]];
-            assert!((got[0] - expected[0]).abs() < 1e-3, "{leg:?} {q:?}: x {} vs {}", got[0], expected[0]);
-            assert!((got[2] - expected[1]).abs() < 1e-3, "{leg:?} {q:?}: z {} vs {}", got[2], expected[1]);
+            assert!(
+                (got[0] - expected[0]).abs() < 1e-3,
+                "{leg:?} {q:?}: x {} vs {}",
+                got[0],
+                expected[0]
+            );
+            assert!(
+                (got[2] - expected[1]).abs() < 1e-3,
+                "{leg:?} {q:?}: z {} vs {}",
+                got[2],
+                expected[1]
+            );
             assert!((got[1] - (base[1] + hip[1])).abs() < 1e-3, "{leg:?}: y");
         }
     }
@@ -36,14 +47,19 @@ fn ik_then_mujoco_forward_kinematics_returns_the_foot() {
     let mut sim = Simulation::robot_only(&common::model()).expect("model compiles");
     let robot = sim.robot().clone();
     for &(x, z) in &[(0.0, -0.27), (0.12, -0.45), (-0.1, -0.6), (0.2, -0.35)] {
-        let q: [[f64; 3]; 4] = Leg::ALL.map(|leg| leg_ik(&robot, leg, [x, z], 0.0).expect("reachable"));
+        let q: [[f64; 3]; 4] =
+            Leg::ALL.map(|leg| leg_ik(&robot, leg, [x, z], 0.0).expect("reachable"));
         sim.place_robot([0.0, 0.0, 1.5], 0.0, &q);
         let base = sim.base().position;
         for leg in Leg::ALL {
             let hip = robot.hips[leg.index()];
             let axle = sim.wheel_pair_centres()[leg.index()];
-            let contact = [axle[0] - base[0] - hip[0], axle[2] - robot.wheel_radius - base[2] - hip[2]];
-            assert!((contact[0] - x).abs() < 1e-3 && (contact[1] - z).abs() < 1e-3, "{leg:?}: {contact:?} vs ({x}, {z})");
+            let contact =
+                [axle[0] - base[0] - hip[0], axle[2] - robot.wheel_radius - base[2] - hip[2]];
+            assert!(
+                (contact[0] - x).abs() < 1e-3 && (contact[1] - z).abs() < 1e-3,
+                "{leg:?}: {contact:?} vs ({x}, {z})"
+            );
         }
     }
 }
@@ -63,15 +79,21 @@ fn urdf_is_in_sync_with_the_mjcf() {
     let sim = Simulation::robot_only(&common::model()).expect("model compiles");
     let generated = momaro::urdf_export::momaro_urdf_string(&sim.urdf_inputs().unwrap()).unwrap();
     let path = common::root().join("models/momaro.urdf");
-    let on_disk = std::fs::read_to_string(&path).expect("models/momaro.urdf exists (run `momaro urdf -o models/momaro.urdf`)");
-    assert_eq!(generated, on_disk, "models/momaro.urdf is stale: regenerate with `cargo run -- urdf -o models/momaro.urdf`");
+    let on_disk = std::fs::read_to_string(&path)
+        .expect("models/momaro.urdf exists (run `momaro urdf -o models/momaro.urdf`)");
+    assert_eq!(
+        generated, on_disk,
+        "models/momaro.urdf is stale: regenerate with `cargo run -- urdf -o models/momaro.urdf`"
+    );
 
     let urdf = urdf_rs::read_file(&path).expect("URDF parses");
     let r = sim.robot();
     assert_eq!(urdf.joints.len(), 4 * 6);
     for leg in Leg::ALL {
         let p = leg.prefix();
-        let j = |name: &str| urdf.joints.iter().find(|j| j.name == format!("{p}_{name}")).expect("joint present");
+        let j = |name: &str| {
+            urdf.joints.iter().find(|j| j.name == format!("{p}_{name}")).expect("joint present")
+        };
         let hip = j("hip");
         for k in 0..3 {
             assert!((hip.origin.xyz[k] - r.hips[leg.index()][k]).abs() < 1e-9);
@@ -80,6 +102,8 @@ fn urdf_is_in_sync_with_the_mjcf() {
         assert!((j("ankle").origin.xyz[2] + r.shin_length).abs() < 1e-9);
         assert!((j("steer").origin.xyz[2] + r.foot_length).abs() < 1e-9);
         assert!((hip.limit.lower - r.joint_ranges[0].min).abs() < 1e-9);
-        assert!((j("wheel_l").origin.xyz[1] - j("wheel_r").origin.xyz[1] - r.wheel_track).abs() < 1e-9);
+        assert!(
+            (j("wheel_l").origin.xyz[1] - j("wheel_r").origin.xyz[1] - r.wheel_track).abs() < 1e-9
+        );
     }
 }

@@ -7,7 +7,8 @@ use momaro::jobs::sim::{SimOptions, SimSummary, run};
 
 fn sim(duration_s: f64, drive: Option<Twist>) -> SimSummary {
     let sc = common::scenario("flat");
-    let opts = SimOptions { duration_s, drive, model_path: common::model(), rerun: None, progress: false };
+    let opts =
+        SimOptions { duration_s, drive, model_path: common::model(), rerun: None, progress: false };
     run(&sc, &opts).expect("sim runs")
 }
 
@@ -16,7 +17,12 @@ fn stands_on_all_eight_wheels_at_nominal_height_for_ten_seconds() {
     let s = sim(10.0, None);
     assert_eq!(s.min_wheels_in_contact, 8, "{s:#?}");
     let height_error = s.base_end[2] - s.nominal_base_height_m;
-    assert!(height_error.abs() < 0.02, "base height {} vs nominal {}", s.base_end[2], s.nominal_base_height_m);
+    assert!(
+        height_error.abs() < 0.02,
+        "base height {} vs nominal {}",
+        s.base_end[2],
+        s.nominal_base_height_m
+    );
     assert!(s.upright && s.body_collisions.is_empty(), "{s:#?}");
     assert!(s.min_stability_margin_m > 0.2, "{s:#?}");
     // Standing still means standing still.

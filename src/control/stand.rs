@@ -9,7 +9,10 @@ use crate::robot::{Leg, RobotDescription};
 ///
 /// # Errors
 /// [`IkError`] if the height is out of the legs' reach.
-pub fn neutral_posture(robot: &RobotDescription, leg_height: f64) -> Result<[[f64; 3]; 4], IkError> {
+pub fn neutral_posture(
+    robot: &RobotDescription,
+    leg_height: f64,
+) -> Result<[[f64; 3]; 4], IkError> {
     let mut q = [[0.0; 3]; 4];
     for leg in Leg::ALL {
         let i = leg.index();

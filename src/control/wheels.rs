@@ -10,8 +10,8 @@
 //! steers, its wheels roll differentially with the steering rate, as Momaro's directly
 //! driven pairs do, instead of scrubbing over the ground.
 
-use crate::robot::{Leg, RobotDescription};
 use crate::geometry::wrap_angle;
+use crate::robot::{Leg, RobotDescription};
 use std::f64::consts::PI;
 
 /// A velocity command in the robot frame: m/s, m/s, rad/s.
@@ -54,7 +54,13 @@ impl Default for WheelKinematics {
 impl WheelKinematics {
     /// Commands for one wheel pair at `foot` = (x', y') in the base frame, given the
     /// steering's measured angle `current_steer`.
-    pub fn pair_command(&self, robot: &RobotDescription, twist: Twist, foot: [f64; 2], current_steer: f64) -> WheelPairCommand {
+    pub fn pair_command(
+        &self,
+        robot: &RobotDescription,
+        twist: Twist,
+        foot: [f64; 2],
+        current_steer: f64,
+    ) -> WheelPairCommand {
         let v = [twist.vx - twist.wz * foot[1], twist.vy + twist.wz * foot[0]];
         let speed = v[0].hypot(v[1]);
         let half_track_turn = twist.wz * robot.wheel_track / 2.0;
@@ -82,20 +88,37 @@ impl WheelKinematics {
         self.gated(robot, steer, current_steer, s)
     }
 
-    fn gated(&self, robot: &RobotDescription, steer: f64, current: f64, linear: [f64; 2]) -> WheelPairCommand {
+    fn gated(
+        &self,
+        robot: &RobotDescription,
+        steer: f64,
+        current: f64,
+        linear: [f64; 2],
+    ) -> WheelPairCommand {
         let err = (steer - current).abs();
         let gate = if err > self.steer_gate_rad { 0.0 } else { err.cos() };
         WheelPairCommand {
             steer,
-            wheel_speeds: [gate * linear[0] / robot.wheel_radius, gate * linear[1] / robot.wheel_radius],
+            wheel_speeds: [
+                gate * linear[0] / robot.wheel_radius,
+                gate * linear[1] / robot.wheel_radius,
+            ],
         }
     }
 
     /// Adds the differential wheel speeds that let a pair turn about its steering axis at
     /// `steer_rate` (rad/s) without scrubbing: left wheel backward, right wheel forward.
-    pub fn with_steering_rate(&self, robot: &RobotDescription, cmd: WheelPairCommand, steer_rate: f64) -> WheelPairCommand {
+    pub fn with_steering_rate(
+        &self,
+        robot: &RobotDescription,
+        cmd: WheelPairCommand,
+        steer_rate: f64,
+    ) -> WheelPairCommand {
         let roll = steer_rate * robot.wheel_track / 2.0 / robot.wheel_radius;
-        WheelPairCommand { steer: cmd.steer, wheel_speeds: [cmd.wheel_speeds[0] - roll, cmd.wheel_speeds[1] + roll] }
+        WheelPairCommand {
+            steer: cmd.steer,
+            wheel_speeds: [cmd.wheel_speeds[0] - roll, cmd.wheel_speeds[1] + roll],
+        }
     }
 
     /// Commands for all four legs with wheel pairs at `feet` (base frame).
@@ -121,7 +144,12 @@ mod tests {
     fn robot() -> RobotDescription {
         let r = Range { min: -2.9, max: 2.9 };
         RobotDescription {
-            hips: [[0.35, 0.32, -0.05], [0.35, -0.32, -0.05], [-0.35, 0.32, -0.05], [-0.35, -0.32, -0.05]],
+            hips: [
+                [0.35, 0.32, -0.05],
+                [0.35, -0.32, -0.05],
+                [-0.35, 0.32, -0.05],
+                [-0.35, -0.32, -0.05],
+            ],
             thigh_length: 0.25,
             shin_length: 0.25,
             foot_length: 0.10,
@@ -135,7 +163,8 @@ mod tests {
         }
     }
 
-    const K: WheelKinematics = WheelKinematics { steer_gate_rad: 0.35, min_speed: 1e-3, steer_limit: 3.1 };
+    const K: WheelKinematics =
+        WheelKinematics { steer_gate_rad: 0.35, min_speed: 1e-3, steer_limit: 3.1 };
 
     #[test]
     fn pure_translation_steers_all_pairs_alike() {
@@ -146,7 +175,10 @@ mod tests {
         for c in K.commands(&rb, twist, &feet, &current) {
             assert!((c.steer - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
             let expected = 0.3 * 2f64.sqrt() / 0.1;
-            assert!((c.wheel_speeds[0] - expected).abs() < 1e-9 && (c.wheel_speeds[1] - expected).abs() < 1e-9);
+            assert!(
+                (c.wheel_speeds[0] - expected).abs() < 1e-9
+                    && (c.wheel_speeds[1] - expected).abs() < 1e-9
+            );
         }
     }
 
@@ -158,14 +190,22 @@ mod tests {
         let c = K.pair_command(&rb, Twist { vx: 0.0, vy: 0.0, wz: 1.0 }, [0.3, 0.4], heading);
         assert!((c.steer - heading).abs() < 1e-12);
         // Left wheel 0.5 − 1·0.1, right 0.5 + 1·0.1, over r = 0.1.
-        assert!((c.wheel_speeds[0] - 4.0).abs() < 1e-9 && (c.wheel_speeds[1] - 6.0).abs() < 1e-9, "{c:?}");
+        assert!(
+            (c.wheel_speeds[0] - 4.0).abs() < 1e-9 && (c.wheel_speeds[1] - 6.0).abs() < 1e-9,
+            "{c:?}"
+        );
     }
 
     #[test]
     fn mixed_twist_adds_velocities() {
         // v = (0.5 − 1·0.0, 0 + 1·0.5) at foot (0.5, 0): heading 45°, |v| = 0.5·√2.
         let rb = robot();
-        let c = K.pair_command(&rb, Twist { vx: 0.5, vy: 0.0, wz: 1.0 }, [0.5, 0.0], std::f64::consts::FRAC_PI_4);
+        let c = K.pair_command(
+            &rb,
+            Twist { vx: 0.5, vy: 0.0, wz: 1.0 },
+            [0.5, 0.0],
+            std::f64::consts::FRAC_PI_4,
+        );
         assert!((c.steer - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
         let s = 0.5 * 2f64.sqrt();
         assert!((c.wheel_speeds[0] - (s - 0.1) / 0.1).abs() < 1e-9);

@@ -138,7 +138,11 @@ pub fn rasterised_map(scenario: &Scenario) -> Result<HeightMap, CostmapError> {
 ///
 /// # Errors
 /// Building the world, placing the robot or scanning fails.
-pub fn sensed_map(scenario: &Scenario, model_path: &Path, raster: &HeightMap) -> Result<(HeightMap, SensedSummary), CostmapError> {
+pub fn sensed_map(
+    scenario: &Scenario,
+    model_path: &Path,
+    raster: &HeightMap,
+) -> Result<(HeightMap, SensedSummary), CostmapError> {
     let mut sim = Simulation::new(scenario, model_path)?;
     super::stand_at_start(&mut sim, scenario)?;
     let laser_origin = sim.site_position("laser")?;
@@ -181,12 +185,19 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
     let layers: Vec<(&str, Option<RgbImage>)> = vec![
         ("height", cost_image::height_image(&heights)),
         ("foot_cost", cost_image::cost_layer_image(&foot, nx, ny, None)),
-        ("body_cost", cost_image::cost_layer_image(&maps.body_cost_layer(theta, leg), nx, ny, None)),
-        ("pose_cost", cost_image::cost_layer_image(&maps.pose_cost_layer(theta, leg), nx, ny, None)),
+        (
+            "body_cost",
+            cost_image::cost_layer_image(&maps.body_cost_layer(theta, leg), nx, ny, None),
+        ),
+        (
+            "pose_cost",
+            cost_image::cost_layer_image(&maps.pose_cost_layer(theta, leg), nx, ny, None),
+        ),
     ];
     let mut images = Vec::new();
     if let Some(dir) = &opts.png_dir {
-        std::fs::create_dir_all(dir).map_err(|source| CostmapError::Dir { path: dir.clone(), source })?;
+        std::fs::create_dir_all(dir)
+            .map_err(|source| CostmapError::Dir { path: dir.clone(), source })?;
         for (name, img) in &layers {
             if let Some(img) = img {
                 let path = dir.join(format!("{}_{name}.png", scenario.name));

@@ -1,6 +1,7 @@
 //! What the CLI's commands do, as library functions returning serialisable summaries, so
 //! tests call exactly what users run.
 
+pub mod bench;
 pub mod costmap;
 pub mod sim;
 
@@ -14,7 +15,10 @@ use crate::sim::Simulation;
 ///
 /// # Errors
 /// [`IkError`] if the driving leg height is out of the legs' reach.
-pub fn stand_at_start(sim: &mut Simulation, scenario: &Scenario) -> Result<([[f64; 3]; 4], f64), IkError> {
+pub fn stand_at_start(
+    sim: &mut Simulation,
+    scenario: &Scenario,
+) -> Result<([[f64; 3]; 4], f64), IkError> {
     let robot = sim.robot().clone();
     let leg_height = scenario.params.driving_leg_height_m;
     let posture = neutral_posture(&robot, leg_height)?;

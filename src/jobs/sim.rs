@@ -110,12 +110,18 @@ fn ramp(current: f64, target: f64, max_step: f64) -> f64 {
 /// diverges or the recording cannot be written.
 pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobError> {
     if !(opts.duration_s.is_finite() && opts.duration_s > 0.0) {
-        return Err(SimJobError::BadOption { option: "--duration", reason: format!("{} must be > 0", opts.duration_s) });
+        return Err(SimJobError::BadOption {
+            option: "--duration",
+            reason: format!("{} must be > 0", opts.duration_s),
+        });
     }
     if let Some(t) = opts.drive
         && !(t.vx.is_finite() && t.vy.is_finite() && t.wz.is_finite())
     {
-        return Err(SimJobError::BadOption { option: "--drive", reason: "components must be finite".into() });
+        return Err(SimJobError::BadOption {
+            option: "--drive",
+            reason: "components must be finite".into(),
+        });
     }
     let mut sim = Simulation::new(scenario, &opts.model_path)?;
     let robot = sim.robot().clone();
@@ -164,7 +170,7 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
             monitor.record(&sample);
         }
         if let Some(r) = &recorder
-            && tick % record_every == 0
+            && tick.is_multiple_of(record_every)
         {
             r.log_bodies(sim.time(), &sim.body_poses())?;
             r.log_stability(&sample, scenario.terrain_height(sample.com[0], sample.com[1]))?;
@@ -187,7 +193,11 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
         base_end: [base_end[0], base_end[1], base_end[2], wrap_angle(base_end[3])],
         nominal_base_height_m: nominal_base_height,
         drive: opts.drive,
-        min_wheels_in_contact: if monitor.min_wheels == usize::MAX { 0 } else { monitor.min_wheels },
+        min_wheels_in_contact: if monitor.min_wheels == usize::MAX {
+            0
+        } else {
+            monitor.min_wheels
+        },
         min_stability_margin_m: monitor.min_margin,
         max_tilt_deg: monitor.max_tilt.to_degrees(),
         upright: !monitor.tipped(),

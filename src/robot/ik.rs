@@ -53,7 +53,12 @@ fn u(a: f64) -> [f64; 2] {
 ///
 /// # Errors
 /// [`IkError`] if the point is out of reach or a joint limit would be passed.
-pub fn leg_ik(robot: &RobotDescription, leg: Leg, contact: [f64; 2], pitch: f64) -> Result<[f64; 3], IkError> {
+pub fn leg_ik(
+    robot: &RobotDescription,
+    leg: Leg,
+    contact: [f64; 2],
+    pitch: f64,
+) -> Result<[f64; 3], IkError> {
     if !(contact[0].is_finite() && contact[1].is_finite() && pitch.is_finite()) {
         return Err(IkError::NotFinite { leg });
     }
@@ -78,7 +83,13 @@ pub fn leg_ik(robot: &RobotDescription, leg: Leg, contact: [f64; 2], pitch: f64)
     for (k, name) in ["hip", "knee", "ankle"].iter().enumerate() {
         let r = robot.joint_ranges[k];
         if !r.contains(q[k]) {
-            return Err(IkError::JointLimit { leg, joint: name, value: q[k], min: r.min, max: r.max });
+            return Err(IkError::JointLimit {
+                leg,
+                joint: name,
+                value: q[k],
+                min: r.min,
+                max: r.max,
+            });
         }
     }
     Ok(q)
@@ -90,7 +101,8 @@ pub fn leg_ik(robot: &RobotDescription, leg: Leg, contact: [f64; 2], pitch: f64)
 pub fn leg_fk(robot: &RobotDescription, q: [f64; 3], pitch: f64) -> [f64; 2] {
     let (a1, a2, a3) = (u(q[0]), u(q[0] + q[1]), u(q[0] + q[1] + q[2]));
     let down = u(-pitch);
-    let (l1, l2, lf, r) = (robot.thigh_length, robot.shin_length, robot.foot_length, robot.wheel_radius);
+    let (l1, l2, lf, r) =
+        (robot.thigh_length, robot.shin_length, robot.foot_length, robot.wheel_radius);
     [
         l1 * a1[0] + l2 * a2[0] + lf * a3[0] + r * down[0],
         l1 * a1[1] + l2 * a2[1] + lf * a3[1] + r * down[1],
@@ -105,7 +117,12 @@ mod tests {
     fn robot() -> RobotDescription {
         let r = Range { min: -2.9, max: 2.9 };
         RobotDescription {
-            hips: [[0.35, 0.32, -0.05], [0.35, -0.32, -0.05], [-0.35, 0.32, -0.05], [-0.35, -0.32, -0.05]],
+            hips: [
+                [0.35, 0.32, -0.05],
+                [0.35, -0.32, -0.05],
+                [-0.35, 0.32, -0.05],
+                [-0.35, -0.32, -0.05],
+            ],
             thigh_length: 0.25,
             shin_length: 0.25,
             foot_length: 0.10,
@@ -141,7 +158,9 @@ mod tests {
     fn ik_fk_round_trip_with_pitch() {
         let rb = robot();
         for leg in Leg::ALL {
-            for &(x, z, pitch) in &[(0.0, -0.27, 0.0), (0.1, -0.5, 0.2), (-0.15, -0.45, -0.25), (0.2, -0.6, 0.1)] {
+            for &(x, z, pitch) in
+                &[(0.0, -0.27, 0.0), (0.1, -0.5, 0.2), (-0.15, -0.45, -0.25), (0.2, -0.6, 0.1)]
+            {
                 let q = leg_ik(&rb, leg, [x, z], pitch).unwrap();
                 let p = leg_fk(&rb, q, pitch);
                 assert!((p[0] - x).abs() < 1e-9 && (p[1] - z).abs() < 1e-9, "{leg:?} {p:?}");
@@ -152,7 +171,13 @@ mod tests {
     #[test]
     fn out_of_reach_and_nan_are_errors() {
         let rb = robot();
-        assert!(matches!(leg_ik(&rb, Leg::RearRight, [0.0, -0.9], 0.0), Err(IkError::OutOfReach { .. })));
-        assert!(matches!(leg_ik(&rb, Leg::RearRight, [f64::NAN, -0.3], 0.0), Err(IkError::NotFinite { .. })));
+        assert!(matches!(
+            leg_ik(&rb, Leg::RearRight, [0.0, -0.9], 0.0),
+            Err(IkError::OutOfReach { .. })
+        ));
+        assert!(matches!(
+            leg_ik(&rb, Leg::RearRight, [f64::NAN, -0.3], 0.0),
+            Err(IkError::NotFinite { .. })
+        ));
     }
 }

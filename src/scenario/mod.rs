@@ -222,7 +222,11 @@ impl Scenario {
 type FieldError = (String, String);
 
 fn finite(field: &str, v: f64) -> Result<(), FieldError> {
-    if v.is_finite() { Ok(()) } else { Err((field.to_owned(), format!("{v} is not a finite number"))) }
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err((field.to_owned(), format!("{v} is not a finite number")))
+    }
 }
 
 fn positive(field: &str, v: f64) -> Result<(), FieldError> {
@@ -243,14 +247,25 @@ fn non_negative(field: &str, v: f64) -> Result<(), FieldError> {
 
 fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
     let m = &f.map;
-    for (name, v) in [("map.x_min", m.x_min), ("map.x_max", m.x_max), ("map.y_min", m.y_min), ("map.y_max", m.y_max)] {
+    for (name, v) in [
+        ("map.x_min", m.x_min),
+        ("map.x_max", m.x_max),
+        ("map.y_min", m.y_min),
+        ("map.y_max", m.y_max),
+    ] {
         finite(name, v)?;
     }
     if m.x_max <= m.x_min {
-        return Err(("map.x_max".into(), format!("{} must exceed map.x_min = {}", m.x_max, m.x_min)));
+        return Err((
+            "map.x_max".into(),
+            format!("{} must exceed map.x_min = {}", m.x_max, m.x_min),
+        ));
     }
     if m.y_max <= m.y_min {
-        return Err(("map.y_max".into(), format!("{} must exceed map.y_min = {}", m.y_max, m.y_min)));
+        return Err((
+            "map.y_max".into(),
+            format!("{} must exceed map.y_min = {}", m.y_max, m.y_min),
+        ));
     }
     for (name, p) in [("start", &f.start), ("goal", &f.goal)] {
         finite(&format!("{name}.x"), p.x)?;
@@ -269,7 +284,9 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
     for (i, prim) in f.terrain.iter().enumerate() {
         validate_primitive(&format!("terrain[{i}]"), prim)?;
     }
-    f.params.validate().map_err(|e| (format!("params.{}", e.name), format!("{} {}", e.value, e.reason)))?;
+    f.params
+        .validate()
+        .map_err(|e| (format!("params.{}", e.name), format!("{} {}", e.value, e.reason)))?;
     // Inside an obstacle: under the base (a disc of the base-circle radius) the terrain
     // rises above its lowest point by more than the clearance under the base while driving.
     // Standing on a platform or a landing is fine; a pole under the base is fine if low.
@@ -282,17 +299,29 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
                 samples.push((p.x + rr * a.cos(), p.y + rr * a.sin()));
             }
         }
-        let heights: Vec<f64> = samples.iter().map(|&(x, y)| terrain::terrain_height(&f.terrain, x, y)).collect();
+        let heights: Vec<f64> =
+            samples.iter().map(|&(x, y)| terrain::terrain_height(&f.terrain, x, y)).collect();
         let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
-        let (k, hi) = heights.iter().copied().enumerate().fold((0, f64::NEG_INFINITY), |a, (k, h)| if h > a.1 { (k, h) } else { a });
+        let (k, hi) = heights
+            .iter()
+            .copied()
+            .enumerate()
+            .fold((0, f64::NEG_INFINITY), |a, (k, h)| if h > a.1 { (k, h) } else { a });
         if hi - lo > f.params.driving_leg_height_m {
             let (x, y) = samples[k];
-            let culprit = f.terrain.iter().position(|prim| prim.surface_height(x, y) == Some(hi)).map_or(String::new(), |i| format!(" (terrain[{i}], {})", f.terrain[i].kind()));
+            let culprit = f
+                .terrain
+                .iter()
+                .position(|prim| prim.surface_height(x, y) == Some(hi))
+                .map_or(String::new(), |i| format!(" (terrain[{i}], {})", f.terrain[i].kind()));
             return Err((
                 name.into(),
                 format!(
                     "({}, {}): terrain{culprit} rises {:.2} m under the base, more than its {:.2} m clearance: the robot would be inside an obstacle",
-                    p.x, p.y, hi - lo, f.params.driving_leg_height_m
+                    p.x,
+                    p.y,
+                    hi - lo,
+                    f.params.driving_leg_height_m
                 ),
             ));
         }
@@ -316,7 +345,15 @@ fn validate_primitive(at: &str, p: &Primitive) -> Result<(), FieldError> {
             positive(&format!("{at}.height"), height)?;
             finite(&format!("{at}.yaw_deg"), yaw_deg)?;
         }
-        Primitive::Stairs { start, width, steps, step_depth, step_height, landing_depth, yaw_deg } => {
+        Primitive::Stairs {
+            start,
+            width,
+            steps,
+            step_depth,
+            step_height,
+            landing_depth,
+            yaw_deg,
+        } => {
             finite(&format!("{at}.start"), start[0])?;
             finite(&format!("{at}.start"), start[1])?;
             positive(&format!("{at}.width"), width)?;
@@ -402,7 +439,10 @@ mod tests {
 
     #[test]
     fn negative_size_names_the_field() {
-        assert_eq!(field_of(&GOOD.replace("size = [0.5, 0.5]", "size = [-0.5, 0.5]")), "terrain[0].size");
+        assert_eq!(
+            field_of(&GOOD.replace("size = [0.5, 0.5]", "size = [-0.5, 0.5]")),
+            "terrain[0].size"
+        );
     }
 
     #[test]
@@ -418,13 +458,18 @@ mod tests {
 
     #[test]
     fn start_inside_an_obstacle_is_rejected() {
-        let text = GOOD.replace("center = [2.0, 1.5]", "center = [0.0, 0.0]").replace("height = 0.2", "height = 0.5");
+        let text = GOOD
+            .replace("center = [2.0, 1.5]", "center = [0.0, 0.0]")
+            .replace("height = 0.2", "height = 0.5");
         assert_eq!(field_of(&text), "start");
     }
 
     #[test]
     fn standing_on_a_platform_is_not_inside_it() {
-        let text = GOOD.replace("center = [2.0, 1.5]", "center = [0.0, 0.0]").replace("size = [0.5, 0.5]", "size = [3.0, 3.0]").replace("height = 0.2", "height = 0.5");
+        let text = GOOD
+            .replace("center = [2.0, 1.5]", "center = [0.0, 0.0]")
+            .replace("size = [0.5, 0.5]", "size = [3.0, 3.0]")
+            .replace("height = 0.2", "height = 0.5");
         parse(&text).unwrap();
     }
 

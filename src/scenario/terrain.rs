@@ -154,7 +154,9 @@ impl Primitive {
                     .map(|&(lx, ly)| to_world(center, yaw_deg.to_radians(), lx, ly))
                     .collect()
             }
-            Primitive::Stairs { start, width, steps, step_depth, landing_depth, yaw_deg, .. } => {
+            Primitive::Stairs {
+                start, width, steps, step_depth, landing_depth, yaw_deg, ..
+            } => {
                 let run = f64::from(steps) * step_depth + landing_depth;
                 let hy = width / 2.0;
                 [(0.0, -hy), (run, -hy), (run, hy), (0.0, hy)]

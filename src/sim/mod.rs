@@ -193,11 +193,14 @@ impl Simulation {
     fn compile(name: &str, xml: &str, model_path: &Path) -> Result<Self, SimError> {
         let robot_xml = std::fs::read(model_path)
             .map_err(|source| SimError::ModelFile { path: model_path.to_owned(), source })?;
-        let compile_err = |message: String| SimError::Compile { scenario: name.to_owned(), message };
+        let compile_err =
+            |message: String| SimError::Compile { scenario: name.to_owned(), message };
         let mut vfs = mujoco_rs::wrappers::mj_auxiliary::MjVfs::new();
-        vfs.add_from_buffer(world::ROBOT_FILE, &robot_xml).map_err(|e| compile_err(e.to_string()))?;
+        vfs.add_from_buffer(world::ROBOT_FILE, &robot_xml)
+            .map_err(|e| compile_err(e.to_string()))?;
         vfs.add_from_buffer("world.xml", xml.as_bytes()).map_err(|e| compile_err(e.to_string()))?;
-        let model = MjModel::from_xml_vfs("world.xml", &vfs).map_err(|e| compile_err(e.to_string()))?;
+        let model =
+            MjModel::from_xml_vfs("world.xml", &vfs).map_err(|e| compile_err(e.to_string()))?;
         Self::from_model(Arc::new(model))
     }
 
@@ -205,17 +208,27 @@ impl Simulation {
         let robot = model::describe(&model)?;
         let joint_adr = |name: &str| -> Result<(usize, usize), SimError> {
             let j = model::id(&model, MjtObjBase::mjOBJ_JOINT, name)?;
-            let q = usize::try_from(model.jnt_qposadr()[j]).map_err(|_| SimError::BadModel(name.into()))?;
-            let v = usize::try_from(model.jnt_dofadr()[j]).map_err(|_| SimError::BadModel(name.into()))?;
+            let q = usize::try_from(model.jnt_qposadr()[j])
+                .map_err(|_| SimError::BadModel(name.into()))?;
+            let v = usize::try_from(model.jnt_dofadr()[j])
+                .map_err(|_| SimError::BadModel(name.into()))?;
             Ok((q, v))
         };
         let mut legs = Vec::with_capacity(4);
         for leg in Leg::ALL {
             let p = leg.prefix();
             let names = model::LegNames::of(leg);
-            let act = |suffix: &str| model::id(&model, MjtObjBase::mjOBJ_ACTUATOR, &format!("{p}_{suffix}"));
-            let actuators =
-                [act("hip")?, act("knee")?, act("ankle")?, act("steer")?, act("wheel_l")?, act("wheel_r")?];
+            let act = |suffix: &str| {
+                model::id(&model, MjtObjBase::mjOBJ_ACTUATOR, &format!("{p}_{suffix}"))
+            };
+            let actuators = [
+                act("hip")?,
+                act("knee")?,
+                act("ankle")?,
+                act("steer")?,
+                act("wheel_l")?,
+                act("wheel_r")?,
+            ];
             let qpos = [
                 joint_adr(&format!("{p}_hip"))?.0,
                 joint_adr(&format!("{p}_knee"))?.0,
@@ -231,7 +244,8 @@ impl Simulation {
             let steer_body = model::id(&model, MjtObjBase::mjOBJ_BODY, &names.steer)?;
             legs.push(LegIds { actuators, qpos, wheel_qvel, steer_qvel, wheel_geoms, steer_body });
         }
-        let legs: [LegIds; 4] = legs.try_into().map_err(|_| SimError::BadModel("leg count".into()))?;
+        let legs: [LegIds; 4] =
+            legs.try_into().map_err(|_| SimError::BadModel("leg count".into()))?;
         let base_body = model::id(&model, MjtObjBase::mjOBJ_BODY, "base")?;
         let (base_qpos, base_qvel) = joint_adr("root")?;
         let terrain_geoms = (0..model.ffi().ngeom as usize)
@@ -293,7 +307,10 @@ impl Simulation {
         }
         let bq = self.base_qpos;
         if self.data.qpos()[bq..bq + 7].iter().any(|v| !v.is_finite()) {
-            return Err(SimError::Diverged { time: self.time(), what: "base pose is not finite".into() });
+            return Err(SimError::Diverged {
+                time: self.time(),
+                what: "base pose is not finite".into(),
+            });
         }
         Ok(())
     }
@@ -387,12 +404,11 @@ impl Simulation {
             if !self.terrain_geoms[other] {
                 continue;
             }
-            for (i, ids) in self.legs.iter().enumerate() {
-                for w in 0..2 {
-                    if ids.wheel_geoms[w] == wheel {
-                        let (sum, n) = &mut sums[i][w];
-                        for k in 0..3 {
-                            sum[k] += c.pos[k];
+            for (ids, leg_sums) in self.legs.iter().zip(sums.iter_mut()) {
+                for (geom, (sum, n)) in ids.wheel_geoms.iter().zip(leg_sums.iter_mut()) {
+                    if *geom == wheel {
+                        for (acc, p) in sum.iter_mut().zip(c.pos) {
+                            *acc += p;
                         }
                         *n += 1;
                     }
@@ -404,7 +420,11 @@ impl Simulation {
             for (w, (sum, n)) in sums[leg.index()].iter().enumerate() {
                 if *n > 0 {
                     let k = f64::from(*n);
-                    out.push(WheelContact { leg, wheel: w, position: [sum[0] / k, sum[1] / k, sum[2] / k] });
+                    out.push(WheelContact {
+                        leg,
+                        wheel: w,
+                        position: [sum[0] / k, sum[1] / k, sum[2] / k],
+                    });
                 }
             }
         }
@@ -416,7 +436,9 @@ impl Simulation {
         let wheels: Vec<usize> = self.legs.iter().flat_map(|l| l.wheel_geoms).collect();
         let mut names = Vec::new();
         for c in self.data.contact() {
-            let (Ok(g1), Ok(g2)) = (usize::try_from(c.geom1), usize::try_from(c.geom2)) else { continue };
+            let (Ok(g1), Ok(g2)) = (usize::try_from(c.geom1), usize::try_from(c.geom2)) else {
+                continue;
+            };
             if c.dist > 1e-3 {
                 continue;
             }
@@ -482,7 +504,11 @@ impl Simulation {
                     rgba: m.geom_rgba()[g],
                     local_position: m.geom_pos()[g],
                     local_quaternion: m.geom_quat()[g],
-                    triangles: if kind == GeomKind::Mesh { self.mesh_triangles(g) } else { Vec::new() },
+                    triangles: if kind == GeomKind::Mesh {
+                        self.mesh_triangles(g)
+                    } else {
+                        Vec::new()
+                    },
                 })
             })
             .collect()
@@ -546,15 +572,30 @@ const LASER_CUTOFF_M: f64 = 30.0;
 /// The simulated laser: MuJoCo's `mj_multiRay` against terrain geoms only (group 0), so
 /// the robot never sees itself.
 impl RayCaster for Simulation {
-    fn cast_rays(&mut self, origin: [f64; 3], directions: &[[f64; 3]], hits: &mut Vec<Option<RayHit>>) {
+    fn cast_rays(
+        &mut self,
+        origin: [f64; 3],
+        directions: &[[f64; 3]],
+        hits: &mut Vec<Option<RayHit>>,
+    ) {
         hits.clear();
         let mut groups = [0u8; mujoco_rs::mujoco_c::mjNGROUP as usize];
         groups[0] = 1;
         let mut normals = vec![[0.0; 3]; directions.len()];
-        match self.data.try_multi_ray(&origin, directions, Some(&groups), true, None, LASER_CUTOFF_M, Some(&mut normals)) {
-            Ok((ids, dist)) => hits.extend(ids.iter().zip(dist).zip(normals).map(|((id, distance), normal)| {
-                (id.is_some() && distance >= 0.0).then_some(RayHit { distance, normal })
-            })),
+        match self.data.try_multi_ray(
+            &origin,
+            directions,
+            Some(&groups),
+            true,
+            None,
+            LASER_CUTOFF_M,
+            Some(&mut normals),
+        ) {
+            Ok((ids, dist)) => {
+                hits.extend(ids.iter().zip(dist).zip(normals).map(|((id, distance), normal)| {
+                    (id.is_some() && distance >= 0.0).then_some(RayHit { distance, normal })
+                }))
+            }
             Err(_) => hits.extend(std::iter::repeat_n(None, directions.len())),
         }
     }

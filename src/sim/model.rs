@@ -91,7 +91,8 @@ pub(crate) fn describe(model: &MjModel) -> Result<RobotDescription, SimError> {
     let [hip_range, knee_range, ankle_range] = joint_ranges;
 
     let numeric = id(model, MjtObjBase::mjOBJ_NUMERIC, "momaro/neutral_foot_offset_x")?;
-    let adr = usize::try_from(model.numeric_adr()[numeric]).map_err(|_| bad("numeric address".into()))?;
+    let adr =
+        usize::try_from(model.numeric_adr()[numeric]).map_err(|_| bad("numeric address".into()))?;
     let size = usize::try_from(model.numeric_size()[numeric]).unwrap_or(0);
     if size != 4 {
         return Err(bad(format!("momaro/neutral_foot_offset_x has {size} values, expected 4")));
@@ -128,7 +129,11 @@ pub(crate) fn urdf_inputs(model: &MjModel) -> Result<crate::urdf_export::UrdfInp
     let robot = describe(model)?;
     let nbody = model.ffi().nbody as usize;
     let body_masses = (1..nbody)
-        .filter_map(|b| model.id_to_name(MjtObjBase::mjOBJ_BODY, b).map(|n| (n.to_owned(), model.body_mass()[b])))
+        .filter_map(|b| {
+            model
+                .id_to_name(MjtObjBase::mjOBJ_BODY, b)
+                .map(|n| (n.to_owned(), model.body_mass()[b]))
+        })
         .collect();
     let mut effort_limits = Vec::new();
     let mut velocity_limits = Vec::new();
@@ -137,10 +142,17 @@ pub(crate) fn urdf_inputs(model: &MjModel) -> Result<crate::urdf_export::UrdfInp
         let force = model.actuator_forcerange()[a];
         effort_limits.push((name.to_owned(), force[0].abs().max(force[1].abs())));
         // Velocity servos (the wheels) have a velocity control range; position servos none.
-        let is_velocity = model.actuator_biastype()[a] == MjtBias::mjBIAS_AFFINE && model.actuator_biasprm()[a][1] == 0.0;
+        let is_velocity = model.actuator_biastype()[a] == MjtBias::mjBIAS_AFFINE
+            && model.actuator_biasprm()[a][1] == 0.0;
         let ctrl = model.actuator_ctrlrange()[a];
         velocity_limits.push((name.to_owned(), if is_velocity { ctrl[1].abs() } else { 0.0 }));
     }
     let steer = model.jnt_range()[id(model, MjtObjBase::mjOBJ_JOINT, "fl_steer")?];
-    Ok(crate::urdf_export::UrdfInputs { robot, body_masses, effort_limits, velocity_limits, steer_range: steer })
+    Ok(crate::urdf_export::UrdfInputs {
+        robot,
+        body_masses,
+        effort_limits,
+        velocity_limits,
+        steer_range: steer,
+    })
 }

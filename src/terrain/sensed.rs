@@ -364,7 +364,12 @@ pub struct SensedAgreement {
 }
 
 /// Compares `sensed` with `raster` (same grid) cell by cell; see [`SensedAgreement`].
-pub fn agreement(primitives: &[Primitive], raster: &HeightMap, sensed: &HeightMap, tolerance: f64) -> SensedAgreement {
+pub fn agreement(
+    primitives: &[Primitive],
+    raster: &HeightMap,
+    sensed: &HeightMap,
+    tolerance: f64,
+) -> SensedAgreement {
     let mut a = SensedAgreement::default();
     for j in 0..raster.ny().min(sensed.ny()) {
         for i in 0..raster.nx().min(sensed.nx()) {

@@ -9,8 +9,8 @@
 
 use crate::cost_image::RgbImage;
 use crate::monitor::StabilitySample;
-use crate::terrain::HeightMap;
 use crate::sim::{BodyPose, GeomKind, GeomShape};
+use crate::terrain::HeightMap;
 use std::path::{Path, PathBuf};
 
 /// Name of the timeline of simulated time.
@@ -84,33 +84,49 @@ impl Recorder {
     /// # Errors
     /// [`VizError`] if writing fails.
     pub fn log_world(&mut self, shapes: &[GeomShape], bodies: &[BodyPose]) -> Result<(), VizError> {
-        self.body_names = std::iter::once("world".to_owned()).chain(bodies.iter().map(|b| b.name.clone())).collect();
+        self.body_names = std::iter::once("world".to_owned())
+            .chain(bodies.iter().map(|b| b.name.clone()))
+            .collect();
         for (i, g) in shapes.iter().enumerate() {
             let name = if g.name.is_empty() { format!("geom_{i}") } else { g.name.clone() };
             let entity = if g.body == 0 {
                 format!("world/terrain/{name}")
             } else {
-                let body = self.body_names.get(g.body).cloned().unwrap_or_else(|| format!("body_{}", g.body));
+                let body = self
+                    .body_names
+                    .get(g.body)
+                    .cloned()
+                    .unwrap_or_else(|| format!("body_{}", g.body));
                 format!("world/robot/{body}/{name}")
             };
             let color = rgba_u8(g.rgba);
             let s = g.size;
-            let pose = rerun::Transform3D::from_translation_rotation(v3(g.local_position), quat(g.local_quaternion));
+            let pose = rerun::Transform3D::from_translation_rotation(
+                v3(g.local_position),
+                quat(g.local_quaternion),
+            );
             self.rec.log_static(entity.as_str(), &pose).map_err(|e| self.err(e))?;
             let logged = match g.kind {
                 GeomKind::Box => self.rec.log_static(
                     entity.as_str(),
-                    &rerun::Boxes3D::from_half_sizes([v3(s)]).with_colors([color]).with_fill_mode(rerun::FillMode::Solid),
+                    &rerun::Boxes3D::from_half_sizes([v3(s)])
+                        .with_colors([color])
+                        .with_fill_mode(rerun::FillMode::Solid),
                 ),
                 GeomKind::Plane => self.rec.log_static(
                     entity.as_str(),
-                    &rerun::Boxes3D::from_centers_and_half_sizes([[0.0, 0.0, -0.001]], [[s[0] as f32, s[1] as f32, 0.001]])
-                        .with_colors([rerun::Color::from_rgb(200, 200, 190)])
-                        .with_fill_mode(rerun::FillMode::Solid),
+                    &rerun::Boxes3D::from_centers_and_half_sizes(
+                        [[0.0, 0.0, -0.001]],
+                        [[s[0] as f32, s[1] as f32, 0.001]],
+                    )
+                    .with_colors([rerun::Color::from_rgb(200, 200, 190)])
+                    .with_fill_mode(rerun::FillMode::Solid),
                 ),
                 GeomKind::Sphere => self.rec.log_static(
                     entity.as_str(),
-                    &rerun::Ellipsoids3D::from_radii([s[0] as f32]).with_colors([color]).with_fill_mode(rerun::FillMode::Solid),
+                    &rerun::Ellipsoids3D::from_radii([s[0] as f32])
+                        .with_colors([color])
+                        .with_fill_mode(rerun::FillMode::Solid),
                 ),
                 GeomKind::Capsule => self.rec.log_static(
                     entity.as_str(),
@@ -128,11 +144,16 @@ impl Recorder {
                         .with_fill_mode(rerun::FillMode::Solid),
                 ),
                 GeomKind::Mesh => {
-                    let vertices: Vec<[f32; 3]> = g.triangles.iter().flat_map(|t| t.map(v3)).collect();
-                    let indices: Vec<[u32; 3]> = (0..g.triangles.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+                    let vertices: Vec<[f32; 3]> =
+                        g.triangles.iter().flat_map(|t| t.map(v3)).collect();
+                    let indices: Vec<[u32; 3]> = (0..g.triangles.len() as u32)
+                        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                        .collect();
                     self.rec.log_static(
                         entity.as_str(),
-                        &rerun::Mesh3D::new(vertices).with_triangle_indices(indices).with_albedo_factor(albedo(g.rgba)),
+                        &rerun::Mesh3D::new(vertices)
+                            .with_triangle_indices(indices)
+                            .with_albedo_factor(albedo(g.rgba)),
                     )
                 }
             };
@@ -148,7 +169,8 @@ impl Recorder {
     pub fn log_bodies(&self, time: f64, bodies: &[BodyPose]) -> Result<(), VizError> {
         self.rec.set_duration_secs(SIM_TIME, time);
         for b in bodies {
-            let t = rerun::Transform3D::from_translation_rotation(v3(b.position), quat(b.quaternion));
+            let t =
+                rerun::Transform3D::from_translation_rotation(v3(b.position), quat(b.quaternion));
             self.rec.log(format!("world/robot/{}", b.name), &t).map_err(|e| self.err(e))?;
         }
         Ok(())
@@ -162,22 +184,34 @@ impl Recorder {
     pub fn log_stability(&self, s: &StabilitySample, ground_z: f64) -> Result<(), VizError> {
         self.rec.set_duration_secs(SIM_TIME, s.time);
         let z = ground_z as f32 + 0.005;
-        let color = if s.margin > 0.0 { rerun::Color::from_rgb(40, 200, 60) } else { rerun::Color::from_rgb(230, 40, 40) };
+        let color = if s.margin > 0.0 {
+            rerun::Color::from_rgb(40, 200, 60)
+        } else {
+            rerun::Color::from_rgb(230, 40, 40)
+        };
         self.rec
             .log(
                 "world/stability/com",
-                &rerun::Points3D::new([[s.com[0] as f32, s.com[1] as f32, z], v3(s.com)]).with_radii([0.025]).with_colors([color]),
+                &rerun::Points3D::new([[s.com[0] as f32, s.com[1] as f32, z], v3(s.com)])
+                    .with_radii([0.025])
+                    .with_colors([color]),
             )
             .map_err(|e| self.err(e))?;
-        let mut ring: Vec<[f32; 3]> = s.support_polygon.iter().map(|p| [p[0] as f32, p[1] as f32, z]).collect();
+        let mut ring: Vec<[f32; 3]> =
+            s.support_polygon.iter().map(|p| [p[0] as f32, p[1] as f32, z]).collect();
         if let Some(first) = ring.first().copied() {
             ring.push(first);
         }
         self.rec
-            .log("world/stability/support_polygon", &rerun::LineStrips3D::new([ring]).with_colors([color]))
+            .log(
+                "world/stability/support_polygon",
+                &rerun::LineStrips3D::new([ring]).with_colors([color]),
+            )
             .map_err(|e| self.err(e))?;
         if s.margin.is_finite() {
-            self.rec.log("plots/stability_margin_m", &rerun::Scalars::single(s.margin)).map_err(|e| self.err(e))?;
+            self.rec
+                .log("plots/stability_margin_m", &rerun::Scalars::single(s.margin))
+                .map_err(|e| self.err(e))?;
         }
         Ok(())
     }
@@ -188,7 +222,9 @@ impl Recorder {
     /// [`VizError`] if writing fails.
     pub fn log_scalar(&self, time: f64, name: &str, value: f64) -> Result<(), VizError> {
         self.rec.set_duration_secs(SIM_TIME, time);
-        self.rec.log(format!("plots/{name}"), &rerun::Scalars::single(value)).map_err(|e| self.err(e))
+        self.rec
+            .log(format!("plots/{name}"), &rerun::Scalars::single(value))
+            .map_err(|e| self.err(e))
     }
 
     /// Logs the known cells of a height map as a static point cloud under
@@ -209,18 +245,27 @@ impl Recorder {
                 }
             }
         }
-        let (lo, hi) = heights.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &h| (a.min(h), b.max(h)));
+        let (lo, hi) = heights
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &h| (a.min(h), b.max(h)));
         let span = if hi > lo { hi - lo } else { 1.0 };
         let colors: Vec<rerun::Color> = heights
             .iter()
             .map(|h| {
                 let t = ((h - lo) / span) as f32;
-                rerun::Color::from_rgb((40.0 + 200.0 * t) as u8, (90.0 + 60.0 * t) as u8, (200.0 - 170.0 * t) as u8)
+                rerun::Color::from_rgb(
+                    (40.0 + 200.0 * t) as u8,
+                    (90.0 + 60.0 * t) as u8,
+                    (200.0 - 170.0 * t) as u8,
+                )
             })
             .collect();
         let radius = (map.resolution() / 2.0) as f32;
         self.rec
-            .log_static("world/height_map", &rerun::Points3D::new(points).with_colors(colors).with_radii([radius]))
+            .log_static(
+                "world/height_map",
+                &rerun::Points3D::new(points).with_colors(colors).with_radii([radius]),
+            )
             .map_err(|e| self.err(e))
     }
 
@@ -229,12 +274,26 @@ impl Recorder {
     ///
     /// # Errors
     /// [`VizError`] if writing fails.
-    pub fn log_layer_image(&self, name: &str, image: &RgbImage, origin: [f64; 2], resolution: f64) -> Result<(), VizError> {
+    pub fn log_layer_image(
+        &self,
+        name: &str,
+        image: &RgbImage,
+        origin: [f64; 2],
+        resolution: f64,
+    ) -> Result<(), VizError> {
         self.rec
-            .log_static(format!("maps/{name}"), &rerun::Image::from_rgb24(image.pixels.clone(), [image.width, image.height]))
+            .log_static(
+                format!("maps/{name}"),
+                &rerun::Image::from_rgb24(image.pixels.clone(), [image.width, image.height]),
+            )
             .map_err(|e| self.err(e))?;
-        let text = format!("{name}: {} x {} cells of {resolution} m, cell (0, 0) at ({}, {}), +y up", image.width, image.height, origin[0], origin[1]);
-        self.rec.log_static(format!("maps/{name}/info"), &rerun::TextDocument::new(text)).map_err(|e| self.err(e))
+        let text = format!(
+            "{name}: {} x {} cells of {resolution} m, cell (0, 0) at ({}, {}), +y up",
+            image.width, image.height, origin[0], origin[1]
+        );
+        self.rec
+            .log_static(format!("maps/{name}/info"), &rerun::TextDocument::new(text))
+            .map_err(|e| self.err(e))
     }
 
     /// Flushes and closes the file.
