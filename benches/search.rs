@@ -46,18 +46,11 @@ impl Grid {
         }
         cells[0] = 1;
         cells[(N * N - 1) as usize] = 1;
-        Grid {
-            cells,
-            goal: (N - 1, N - 1),
-        }
+        Grid { cells, goal: (N - 1, N - 1) }
     }
 
     fn cell(&self, x: i32, y: i32) -> u8 {
-        if x < 0 || y < 0 || x >= N || y >= N {
-            0
-        } else {
-            self.cells[(y * N + x) as usize]
-        }
+        if x < 0 || y < 0 || x >= N || y >= N { 0 } else { self.cells[(y * N + x) as usize] }
     }
 }
 
@@ -65,23 +58,10 @@ impl SearchGraph for Grid {
     type State = (i32, i32);
     fn successors(&mut self, (x, y): (i32, i32), out: &mut Vec<((i32, i32), Cost)>) {
         let here = u64::from(self.cell(x, y));
-        for (dx, dy) in [
-            (1, 0),
-            (1, 1),
-            (0, 1),
-            (-1, 1),
-            (-1, 0),
-            (-1, -1),
-            (0, -1),
-            (1, -1),
-        ] {
+        for (dx, dy) in [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)] {
             let there = u64::from(self.cell(x + dx, y + dy));
             if there > 0 {
-                let len = if dx != 0 && dy != 0 {
-                    DIAGONAL
-                } else {
-                    STRAIGHT
-                };
+                let len = if dx != 0 && dy != 0 { DIAGONAL } else { STRAIGHT };
                 out.push(((x + dx, y + dy), Cost(len * (here + there) / 2)));
             }
         }
@@ -99,15 +79,9 @@ impl SearchGraph for Grid {
 fn bench(c: &mut Criterion) {
     let mut grid = Grid::new();
     let exact = astar(&mut grid, (0, 0), &SearchParams::default());
-    let opt = exact
-        .best()
-        .map(|s| s.cost)
-        .expect("the benchmark grid is solvable");
-    let first_params = SearchParams {
-        initial_epsilon: 3.0,
-        final_epsilon: 3.0,
-        ..SearchParams::default()
-    };
+    let opt = exact.best().map(|s| s.cost).expect("the benchmark grid is solvable");
+    let first_params =
+        SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
     let full = arastar(&mut grid, (0, 0), &SearchParams::default()).expect("valid params");
     assert_eq!(full.best().map(|s| s.cost), Some(opt));
     let first = full.first().expect("first solution");

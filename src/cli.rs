@@ -8,6 +8,15 @@ use anyhow::Context as _;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
+/// Prints a line to stdout; a closed pipe (`momaro ... | head`) is not an error worth a
+/// panic, so write errors are ignored.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 /// Closed-loop simulator of hybrid driving-stepping locomotion for Momaro (Klamt & Behnke, IROS 2017).
 #[derive(Debug, Parser)]
 #[command(name = "momaro", version, about)]
@@ -69,6 +78,52 @@ pub enum Command {
     /// Measure speed (medians over repeats; never asserted in tests).
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Plan a hybrid driving-stepping path for a scenario (A* or anytime ARA*).
+    Plan {
+        /// Scenario file.
+        scenario: PathBuf,
+        #[command(flatten)]
+        planner: PlannerArgs,
+        /// Write a Rerun recording of the maps and the path.
+        #[arg(long, value_name = "FILE.rrd")]
+        rerun: Option<PathBuf>,
+        /// Print the result as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// Plan, then execute the plan in closed loop in MuJoCo; exit 0 only if the scenario's
+    /// expectations hold.
+    Run {
+        /// Scenario file.
+        scenario: PathBuf,
+        #[command(flatten)]
+        planner: PlannerArgs,
+        /// Noise on the measured base pose: position std (m), yaw std (degrees), seed.
+        #[arg(long, value_name = "POS_M,YAW_DEG,SEED", value_parser = parse_noise)]
+        noise: Option<jobs::run::PoseNoise>,
+        /// Write a Rerun recording.
+        #[arg(long, value_name = "FILE.rrd")]
+        rerun: Option<PathBuf>,
+        /// Print the summary as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// Run scenarios in closed loop and print a table; exit non-zero if any fails.
+    Check {
+        /// Scenario files (default: every scenarios/*.toml).
+        scenarios: Vec<PathBuf>,
+        #[command(flatten)]
+        planner: PlannerArgs,
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
     /// Write the URDF of the robot, generated from the MJCF model.
     Urdf {
         /// Output file (default: standard output).
@@ -79,9 +134,67 @@ pub enum Command {
     },
 }
 
+/// Search algorithm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum AlgorithmArg {
+    /// Optimal A*.
+    Astar,
+    /// Anytime Repairing A* (Likhachev et al. 2003).
+    Arastar,
+}
+
+/// Planner options shared by `plan`, `run` and `check`.
+#[derive(Debug, Args)]
+pub struct PlannerArgs {
+    /// Search algorithm.
+    #[arg(long, value_enum, default_value_t = AlgorithmArg::Arastar)]
+    pub algorithm: AlgorithmArg,
+    /// Planning time limit, s (always held).
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    pub time_limit: f64,
+    /// ARA*'s initial heuristic weight (default: the scenario's, 3.0).
+    #[arg(long, allow_negative_numbers = true)]
+    pub initial_epsilon: Option<f64>,
+    /// Orientation cost factor k12 (default: the scenario's, 2.0).
+    #[arg(long, allow_negative_numbers = true)]
+    pub k12: Option<f64>,
+}
+
+impl PlannerArgs {
+    fn options(&self) -> jobs::plan::PlanOptions {
+        jobs::plan::PlanOptions {
+            algorithm: match self.algorithm {
+                AlgorithmArg::Astar => crate::locomotion::driving::Algorithm::AStar,
+                AlgorithmArg::Arastar => crate::locomotion::driving::Algorithm::AraStar,
+            },
+            time_limit_s: self.time_limit,
+            initial_epsilon: self.initial_epsilon,
+            k12: self.k12,
+            ..jobs::plan::PlanOptions::default()
+        }
+    }
+}
+
 /// The benchmarks.
 #[derive(Debug, Subcommand)]
 pub enum BenchCommand {
+    /// Planner speed: time to first solution, cost over the optimum, cost after 1 s and 10 s,
+    /// time to the optimum, for A* and ARA*.
+    Plan {
+        /// Scenario file.
+        scenario: PathBuf,
+        /// ARA* time budget, s.
+        #[arg(long, default_value_t = 10.0)]
+        arastar_limit: f64,
+        /// Time budget of the A* run that finds the optimum, s.
+        #[arg(long, default_value_t = 120.0)]
+        optimum_limit: f64,
+        /// Print the result as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
     /// Real-time factor of `momaro sim` against a bare mj_step loop on the same world.
     Sim {
         /// Scenario file.
@@ -98,6 +211,24 @@ pub enum BenchCommand {
         #[command(flatten)]
         model: ModelArgs,
     },
+}
+
+fn parse_noise(s: &str) -> Result<jobs::run::PoseNoise, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected POS_M,YAW_DEG,SEED, got `{s}`"));
+    }
+    let num = |p: &str| -> Result<f64, String> {
+        p.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v >= 0.0)
+            .ok_or_else(|| format!("`{p}` is not a finite number >= 0"))
+    };
+    Ok(jobs::run::PoseNoise {
+        position_std_m: num(parts[0])?,
+        yaw_std_rad: num(parts[1])?.to_radians(),
+        seed: parts[2].parse().map_err(|e| format!("seed `{}`: {e}", parts[2]))?,
+    })
 }
 
 fn parse_twist(s: &str) -> Result<Twist, String> {
@@ -120,12 +251,45 @@ fn parse_twist(s: &str) -> Result<Twist, String> {
 #[error("{0}")]
 pub struct BadInput(pub String);
 
+fn plan_error(e: jobs::plan::PlanJobError) -> anyhow::Error {
+    use jobs::plan::PlanJobError as E;
+    match e {
+        E::BadOption { .. } | E::Params { .. } | E::OffMap { .. } | E::Untraversable { .. } => {
+            anyhow::Error::new(BadInput(e.to_string()))
+        }
+        other => anyhow::Error::new(other),
+    }
+}
+
+fn run_error(e: jobs::run::RunJobError) -> anyhow::Error {
+    match e {
+        jobs::run::RunJobError::Plan(p) => plan_error(p),
+        other => anyhow::Error::new(other),
+    }
+}
+
+fn robot(model: &std::path::Path) -> anyhow::Result<crate::robot::RobotDescription> {
+    Ok(crate::sim::Simulation::robot_only(model)?.robot().clone())
+}
+
+/// Every `scenarios/*.toml` of the repository, sorted.
+fn all_scenarios() -> anyhow::Result<Vec<PathBuf>> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .with_context(|| format!("listing {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    Ok(v)
+}
+
 fn load(path: &std::path::Path) -> anyhow::Result<Scenario> {
     Scenario::load(path).map_err(|e: ScenarioError| anyhow::Error::new(BadInput(e.to_string())))
 }
 
 fn print_json<T: serde::Serialize>(value: &T) -> anyhow::Result<()> {
-    println!("{}", serde_json::to_string_pretty(value).context("serialising the summary")?);
+    say!("{}", serde_json::to_string_pretty(value).context("serialising the summary")?);
     Ok(())
 }
 
@@ -154,30 +318,32 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 print_json(&summary)?;
             } else {
                 let s = &summary;
-                println!("scenario            {}", s.scenario);
-                println!(
+                say!("scenario            {}", s.scenario);
+                say!(
                     "sim time            {:.2} s in {:.2} s wall (x{:.1} real time)",
-                    s.sim_time_s, s.wall_time_s, s.real_time_factor
+                    s.sim_time_s,
+                    s.wall_time_s,
+                    s.real_time_factor
                 );
-                println!(
+                say!(
                     "base start          x {:.3}  y {:.3}  z {:.3}  yaw {:.1}°",
                     s.base_start[0],
                     s.base_start[1],
                     s.base_start[2],
                     s.base_start[3].to_degrees()
                 );
-                println!(
+                say!(
                     "base end            x {:.3}  y {:.3}  z {:.3}  yaw {:.1}°",
                     s.base_end[0],
                     s.base_end[1],
                     s.base_end[2],
                     s.base_end[3].to_degrees()
                 );
-                println!("wheels in contact   min {}", s.min_wheels_in_contact);
-                println!("stability margin    min {:.3} m", s.min_stability_margin_m);
-                println!("upright             {}", s.upright);
+                say!("wheels in contact   min {}", s.min_wheels_in_contact);
+                say!("stability margin    min {:.3} m", s.min_stability_margin_m);
+                say!("upright             {}", s.upright);
                 if !s.body_collisions.is_empty() {
-                    println!("body collisions     {}", s.body_collisions.join(", "));
+                    say!("body collisions     {}", s.body_collisions.join(", "));
                 }
             }
             Ok(summary.upright && summary.body_collisions.is_empty())
@@ -195,22 +361,27 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             if json {
                 print_json(&s)?;
             } else {
-                println!("scenario            {} ({} height map)", s.scenario, s.source);
-                println!(
+                say!("scenario            {} ({} height map)", s.scenario, s.source);
+                say!(
                     "map                 {} x {} cells of {} m from ({}, {})",
-                    s.cells[0], s.cells[1], s.resolution_m, s.origin[0], s.origin[1]
+                    s.cells[0],
+                    s.cells[1],
+                    s.resolution_m,
+                    s.origin[0],
+                    s.origin[1]
                 );
-                println!(
+                say!(
                     "build time          height map {:.1} ms, cost layers {:.1} ms",
                     s.height_map_time_s * 1e3,
                     s.cost_maps_time_s * 1e3
                 );
-                println!(
+                say!(
                     "foot cost cells     {} infinite, {} unknown",
-                    s.infinite_foot_cells, s.unknown_foot_cells
+                    s.infinite_foot_cells,
+                    s.unknown_foot_cells
                 );
                 if let Some(sensed) = &s.sensed {
-                    println!(
+                    say!(
                         "laser               {} rays, {} cells seen, max error on flat cells {:.4} m, {} violations",
                         sensed.rays,
                         sensed.seen_cells,
@@ -219,7 +390,198 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                     );
                 }
                 for img in &s.images {
-                    println!("wrote               {}", img.display());
+                    say!("wrote               {}", img.display());
+                }
+            }
+            Ok(true)
+        }
+        Command::Plan { scenario, planner, rerun, json, model } => {
+            let sc = load(&scenario)?;
+            let robot = robot(&model.model)?;
+            let summary = jobs::plan::run(&sc, &robot, &planner.options()).map_err(plan_error)?;
+            if let Some(path) = rerun {
+                jobs::plan_recording::record(&sc, &robot, &summary, &path)
+                    .with_context(|| format!("recording {}", path.display()))?;
+            }
+            if json {
+                print_json(&summary)?;
+            } else {
+                say!("scenario            {} ({})", summary.scenario, summary.algorithm);
+                for s in &summary.solutions {
+                    say!(
+                        "solution            ε {:.3}  cost {:.3}  {:.1} ms  {} expansions",
+                        s.epsilon,
+                        s.cost,
+                        s.time_s * 1e3,
+                        s.expansions
+                    );
+                }
+                say!(
+                    "path                {} poses, {} steps, cost {:.3}",
+                    summary.path.len(),
+                    summary.steps,
+                    summary.cost
+                );
+                say!(
+                    "planning            {:.1} ms ({})",
+                    summary.planning_time_s * 1e3,
+                    summary.termination
+                );
+            }
+            Ok(true)
+        }
+        Command::Run { scenario, planner, noise, rerun, json, model } => {
+            let sc = load(&scenario)?;
+            let opts = jobs::run::RunOptions {
+                plan: planner.options(),
+                follower: crate::control::path_follower::FollowerConfig::default(),
+                model_path: model.model,
+                rerun,
+                progress: !json,
+                noise,
+            };
+            let s = jobs::run::run(&sc, &opts).map_err(run_error)?;
+            if json {
+                print_json(&s)?;
+            } else {
+                say!("scenario            {}", s.scenario);
+                say!("result              {}", if s.passed { "PASS" } else { "FAIL" });
+                say!(
+                    "plan                cost {:.3}, {} steps, {:.1} ms",
+                    s.plan_cost,
+                    s.plan_steps,
+                    s.planning_time_s * 1e3
+                );
+                say!(
+                    "goal error          {:.3} m, {:.1}°",
+                    s.goal_position_error_m,
+                    s.goal_heading_error_rad.to_degrees()
+                );
+                say!("stability margin    min {:.3} m", s.min_stability_margin_m);
+                say!(
+                    "tracking error      max {:.3} m, mean {:.3} m",
+                    s.max_tracking_error_m,
+                    s.mean_tracking_error_m
+                );
+                say!(
+                    "sim time            {:.1} s in {:.1} s wall (x{:.1} real time)",
+                    s.sim_time_s,
+                    s.wall_time_s,
+                    s.real_time_factor
+                );
+                for e in &s.expectations {
+                    say!(
+                        "  {} {:<22} {}",
+                        if e.passed { "ok  " } else { "FAIL" },
+                        e.name,
+                        e.detail
+                    );
+                }
+            }
+            Ok(s.passed)
+        }
+        Command::Check { scenarios, planner, json, model } => {
+            let files = if scenarios.is_empty() { all_scenarios()? } else { scenarios };
+            let mut rows = Vec::new();
+            let mut all_passed = true;
+            if !json {
+                say!(
+                    "{:<16} {:<7} {:>11} {:>11} {:>9} {:>9}",
+                    "scenario",
+                    "result",
+                    "goal err m",
+                    "margin m",
+                    "sim s",
+                    "wall s"
+                );
+            }
+            for file in &files {
+                let sc = load(file)?;
+                let opts = jobs::run::RunOptions {
+                    plan: planner.options(),
+                    follower: crate::control::path_follower::FollowerConfig::default(),
+                    model_path: model.model.clone(),
+                    rerun: None,
+                    progress: false,
+                    noise: None,
+                };
+                let row = match jobs::run::run(&sc, &opts) {
+                    Ok(s) => {
+                        if !json {
+                            say!(
+                                "{:<16} {:<7} {:>11.3} {:>11.3} {:>9.1} {:>9.1}",
+                                s.scenario,
+                                if s.passed { "PASS" } else { "FAIL" },
+                                s.goal_position_error_m,
+                                s.min_stability_margin_m,
+                                s.sim_time_s,
+                                s.wall_time_s
+                            );
+                        }
+                        all_passed &= s.passed;
+                        serde_json::to_value(&s).context("serialising")?
+                    }
+                    Err(e) => {
+                        if !json {
+                            say!("{:<16} {:<7} {e}", sc.name, "ERROR");
+                        }
+                        all_passed = false;
+                        serde_json::json!({ "scenario": sc.name, "passed": false, "error": e.to_string() })
+                    }
+                };
+                rows.push(row);
+            }
+            if json {
+                print_json(&rows)?;
+            }
+            Ok(all_passed)
+        }
+        Command::Bench(BenchCommand::Plan {
+            scenario,
+            arastar_limit,
+            optimum_limit,
+            json,
+            model,
+        }) => {
+            let sc = load(&scenario)?;
+            let opts = jobs::plan::BenchOptions {
+                arastar_time_limit_s: arastar_limit,
+                optimum_time_limit_s: optimum_limit,
+                ..Default::default()
+            };
+            let report =
+                jobs::plan::bench(&sc, &robot(&model.model)?, &opts).map_err(plan_error)?;
+            if json {
+                print_json(&report)?;
+            } else {
+                let pct = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.1} %"));
+                let ms =
+                    |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{:.1} ms", v * 1e3));
+                let c = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.3}"));
+                say!("scenario {} (setup {:.1} ms)", report.scenario, report.setup_time_s * 1e3);
+                say!(
+                    "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12}",
+                    "algo",
+                    "nbhd",
+                    "optimum",
+                    "first",
+                    "over opt",
+                    "cost@1s",
+                    "cost@10s",
+                    "to optimum"
+                );
+                for r in &report.rows {
+                    say!(
+                        "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12}",
+                        r.algorithm,
+                        r.neighbourhood,
+                        c(r.optimum),
+                        ms(r.first_solution_s),
+                        pct(r.first_over_optimum_pct),
+                        c(r.cost_at_1s),
+                        c(r.cost_at_10s),
+                        ms(r.time_to_optimum_s)
+                    );
                 }
             }
             Ok(true)
@@ -238,19 +600,24 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             if json {
                 print_json(&b)?;
             } else {
-                println!(
+                say!(
                     "scenario            {} ({} s simulated, {} steps, median of {})",
-                    b.scenario, b.sim_time_s, b.steps, b.repeats
+                    b.scenario,
+                    b.sim_time_s,
+                    b.steps,
+                    b.repeats
                 );
-                println!(
+                say!(
                     "bare mj_step loop   x{:.1} real time ({:.2} µs/step)",
-                    b.bare_real_time_factor, b.bare_step_us
+                    b.bare_real_time_factor,
+                    b.bare_step_us
                 );
-                println!(
+                say!(
                     "momaro sim          x{:.1} real time ({:.2} µs/step)",
-                    b.controlled_real_time_factor, b.controlled_step_us
+                    b.controlled_real_time_factor,
+                    b.controlled_step_us
                 );
-                println!("controller+monitor  {:.1} % of a step", b.overhead_fraction * 100.0);
+                say!("controller+monitor  {:.1} % of a step", b.overhead_fraction * 100.0);
             }
             Ok(true)
         }

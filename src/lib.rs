@@ -8,6 +8,7 @@ pub mod cost;
 pub mod cost_image;
 pub mod geometry;
 pub mod jobs;
+pub mod locomotion;
 pub mod monitor;
 pub mod params;
 pub mod planner;

@@ -193,3 +193,20 @@ fn recording_verifies_with_rerun() {
         String::from_utf8_lossy(&verify.stderr)
     );
 }
+
+#[test]
+fn closed_stdout_is_not_a_panic() {
+    // `momaro ... | head -1`: the reader goes away before the output is written.
+    let scenario = common::root().join("scenarios/flat.toml");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_momaro"))
+        .args(["costmap", scenario.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("waits");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(out.status.success(), "{stderr}");
+}

@@ -3,6 +3,9 @@
 
 pub mod bench;
 pub mod costmap;
+pub mod plan;
+pub mod plan_recording;
+pub mod run;
 pub mod sim;
 
 use crate::control::stand::neutral_posture;

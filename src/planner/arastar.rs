@@ -47,14 +47,8 @@ pub fn arastar_with_hooks<G: SearchGraph>(
 ) -> Result<SearchResult<G::State>, SearchError> {
     let schedule = params.schedule()?;
     // Fig. 3, lines 01'–02': g(start) = 0, OPEN = {start}, ε = ε₀.
-    let mut engine = Engine::new(
-        graph,
-        start,
-        params,
-        hooks,
-        schedule.initial,
-        ClosedPolicy::Incons,
-    );
+    let mut engine =
+        Engine::new(graph, start, params, hooks, schedule.initial, ClosedPolicy::Incons);
     if !engine.started() {
         return Ok(engine.finish(Termination::StateLimit));
     }

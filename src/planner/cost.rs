@@ -61,20 +61,12 @@ impl Cost {
             return Cost::ZERO;
         }
         let micro = round(units * Self::SCALE as f64);
-        if micro >= u64::MAX as f64 {
-            Cost::INFINITY
-        } else {
-            Cost(micro as u64)
-        }
+        if micro >= u64::MAX as f64 { Cost::INFINITY } else { Cost(micro as u64) }
     }
 
     /// The cost in units (`+∞` for [`Cost::INFINITY`]).
     pub fn to_f64(self) -> f64 {
-        if self.is_infinite() {
-            f64::INFINITY
-        } else {
-            self.0 as f64 / Self::SCALE as f64
-        }
+        if self.is_infinite() { f64::INFINITY } else { self.0 as f64 / Self::SCALE as f64 }
     }
 
     /// Whether this is [`Cost::INFINITY`].
@@ -118,12 +110,7 @@ impl fmt::Debug for Cost {
         if self.is_infinite() {
             write!(f, "Cost(inf)")
         } else {
-            write!(
-                f,
-                "Cost({}.{:06})",
-                self.0 / Self::SCALE,
-                self.0 % Self::SCALE
-            )
+            write!(f, "Cost({}.{:06})", self.0 / Self::SCALE, self.0 % Self::SCALE)
         }
     }
 }
@@ -162,10 +149,7 @@ mod tests {
     fn addition_saturates() {
         assert_eq!(Cost::INFINITY + Cost::ONE, Cost::INFINITY);
         assert_eq!(Cost(u64::MAX - 1) + Cost(5), Cost::INFINITY);
-        assert_eq!(
-            [Cost(1), Cost(2), Cost(3)].into_iter().sum::<Cost>(),
-            Cost(6)
-        );
+        assert_eq!([Cost(1), Cost(2), Cost(3)].into_iter().sum::<Cost>(), Cost(6));
         assert_eq!(Cost(3).saturating_sub(Cost(5)), Cost::ZERO);
     }
 

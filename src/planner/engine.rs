@@ -57,9 +57,10 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
         eps: u64,
         policy: ClosedPolicy,
     ) -> Self {
+        let dense_len = graph.dense_len();
         let mut engine = Self {
             graph,
-            store: NodeStore::new(params.max_states),
+            store: NodeStore::new(params.max_states, dense_len),
             open: OpenList::new(),
             incons: Vec::new(),
             succ: Vec::with_capacity(32),
@@ -78,11 +79,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             n.g = Cost::ZERO;
             n.set_open(true);
             let (h, goal) = (n.h, n.is_goal());
-            engine.open.push(Entry {
-                key: weighted_key(Cost::ZERO, h, eps),
-                h: h.0,
-                node: id,
-            });
+            engine.open.push(Entry { key: weighted_key(Cost::ZERO, h, eps), h: h.0, node: id });
             if goal {
                 engine.goal = Some(id);
             }
@@ -178,11 +175,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 // lines 09–10: if s' ∉ CLOSED, insert/update s' in OPEN with fvalue(s')
                 tn.set_open(true);
                 let h = tn.h;
-                self.open.push(Entry {
-                    key: weighted_key(ng, h, eps),
-                    h: h.0,
-                    node: tid,
-                });
+                self.open.push(Entry { key: weighted_key(ng, h, eps), h: h.0, node: tid });
             }
         }
     }
@@ -190,11 +183,8 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     /// `min_{s ∈ OPEN ∪ INCONS} (g(s) + h(s))`, a lower bound on the optimal cost for a
     /// consistent heuristic (Likhachev et al. 2003, Sec. 4, ε′). ∞ if both are empty.
     pub fn lower_bound(&self) -> Cost {
-        let open = self
-            .open
-            .iter()
-            .filter(|e| Self::is_valid(&self.store, e, self.eps))
-            .map(|e| e.node);
+        let open =
+            self.open.iter().filter(|e| Self::is_valid(&self.store, e, self.eps)).map(|e| e.node);
         open.chain(self.incons.iter().copied())
             .map(|id| {
                 let n = self.store.get(id);
@@ -251,11 +241,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             n.set_incons(false);
             if !n.in_open() {
                 n.set_open(true);
-                entries.push(Entry {
-                    key: weighted_key(n.g, n.h, new_eps),
-                    h: n.h.0,
-                    node: id,
-                });
+                entries.push(Entry { key: weighted_key(n.g, n.h, new_eps), h: n.h.0, node: id });
             }
         }
         self.open.rebuild(entries);

@@ -37,6 +37,29 @@ pub trait SearchGraph {
 
     /// Whether `state` is a goal.
     fn is_goal(&self, state: Self::State) -> bool;
+
+    /// Optional: the size of a dense index space, `0` (the default) if the graph has none.
+    ///
+    /// A graph whose states (or most of them, e.g. the cells × orientations of a lattice)
+    /// map to small integers can return their count here and the index from
+    /// [`dense_index`](Self::dense_index). The search then finds a state's record with one
+    /// array read instead of a hash look-up — on a pose lattice the hash look-up is most of
+    /// the cost of an expansion, because neighbouring states scatter over the table. States
+    /// without a dense index still go through the hash map, so a graph may index only the
+    /// common kind of state. The search allocates 4 bytes per index (zeroed memory, so
+    /// untouched pages cost nothing).
+    fn dense_len(&self) -> usize {
+        0
+    }
+
+    /// Optional: the dense index of `state`, in `0..dense_len()`, or `None` for a state
+    /// that has none (see [`dense_len`](Self::dense_len)). Must be injective: two
+    /// different states never share an index. An index `>= dense_len()` is treated as
+    /// `None`.
+    fn dense_index(&self, state: Self::State) -> Option<usize> {
+        let _ = state;
+        None
+    }
 }
 
 impl<G: SearchGraph + ?Sized> SearchGraph for &mut G {
@@ -52,5 +75,13 @@ impl<G: SearchGraph + ?Sized> SearchGraph for &mut G {
 
     fn is_goal(&self, state: Self::State) -> bool {
         (**self).is_goal(state)
+    }
+
+    fn dense_len(&self) -> usize {
+        (**self).dense_len()
+    }
+
+    fn dense_index(&self, state: Self::State) -> Option<usize> {
+        (**self).dense_index(state)
     }
 }

@@ -9,7 +9,6 @@
 
 use super::{Cost, SearchGraph, Termination};
 use std::collections::HashMap;
-use std::collections::hash_map::Entry as MapEntry;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -171,25 +170,49 @@ impl<S> Node<S> {
 /// The weighted key `g·EPS_SCALE + ε_milli·h`, saturating.
 #[inline]
 pub(crate) fn weighted_key(g: Cost, h: Cost, eps_milli: u64) -> u64 {
-    g.0.saturating_mul(super::params::EPS_SCALE)
-        .saturating_add(h.0.saturating_mul(eps_milli))
+    g.0.saturating_mul(super::params::EPS_SCALE).saturating_add(h.0.saturating_mul(eps_milli))
 }
 
 /// All generated states.
 pub(crate) struct NodeStore<S> {
+    /// States without a dense index (or all, for graphs without one).
     index: HashMap<S, NodeId, FxBuild>,
+    /// Node id + 1 by dense index (0: not generated), for graphs that provide one
+    /// ([`SearchGraph::dense_len`]). Zero-initialised, so the allocation is lazy.
+    dense: Vec<u32>,
     pub nodes: Vec<Node<S>>,
     limit: usize,
 }
 
 impl<S: Copy + Eq + std::hash::Hash> NodeStore<S> {
-    pub fn new(max_states: Option<usize>) -> Self {
+    /// An empty store; `dense_len` is the graph's [`SearchGraph::dense_len`].
+    pub fn new(max_states: Option<usize>, dense_len: usize) -> Self {
         let cap = (NO_NODE - 1) as usize;
         Self {
             index: HashMap::default(),
+            dense: vec![0; dense_len],
             nodes: Vec::new(),
             limit: max_states.map_or(cap, |m| m.min(cap)),
         }
+    }
+
+    /// Appends a new node for `state` (g = ∞, h and goal flag from `graph`); `None` when
+    /// the store is full.
+    #[inline]
+    fn push_new<G: SearchGraph<State = S>>(&mut self, graph: &G, state: S) -> Option<NodeId> {
+        if self.nodes.len() >= self.limit {
+            return None;
+        }
+        let id = self.nodes.len() as NodeId;
+        let meta = if graph.is_goal(state) { GOAL } else { 0 };
+        self.nodes.push(Node {
+            state,
+            g: Cost::INFINITY,
+            h: graph.heuristic(state),
+            parent: NO_NODE,
+            meta,
+        });
+        Some(id)
     }
 
     /// The id of `state`, generating it (g = ∞, h and goal flag from `graph`) if new.
@@ -200,25 +223,21 @@ impl<S: Copy + Eq + std::hash::Hash> NodeStore<S> {
         graph: &G,
         state: S,
     ) -> Option<NodeId> {
-        match self.index.entry(state) {
-            MapEntry::Occupied(e) => Some(*e.get()),
-            MapEntry::Vacant(v) => {
-                if self.nodes.len() >= self.limit {
-                    return None;
-                }
-                let id = self.nodes.len() as NodeId;
-                v.insert(id);
-                let meta = if graph.is_goal(state) { GOAL } else { 0 };
-                self.nodes.push(Node {
-                    state,
-                    g: Cost::INFINITY,
-                    h: graph.heuristic(state),
-                    parent: NO_NODE,
-                    meta,
-                });
-                Some(id)
+        if let Some(k) = graph.dense_index(state).filter(|&k| k < self.dense.len()) {
+            let slot = self.dense[k];
+            if slot != 0 {
+                return Some(slot - 1);
             }
+            let id = self.push_new(graph, state)?;
+            self.dense[k] = id + 1;
+            return Some(id);
         }
+        if let Some(&id) = self.index.get(&state) {
+            return Some(id);
+        }
+        let id = self.push_new(graph, state)?;
+        self.index.insert(state, id);
+        Some(id)
     }
 
     #[inline]
@@ -355,11 +374,7 @@ mod tests {
                 buckets.insert(b.hash_one((x, y)) & 1023);
             }
         }
-        assert!(
-            buckets.len() > 200,
-            "only {} distinct buckets",
-            buckets.len()
-        );
+        assert!(buckets.len() > 200, "only {} distinct buckets", buckets.len());
         let mut h = FxHasher::default();
         [1u8, 2, 3, 4, 5, 6, 7, 8, 9].hash(&mut h);
         assert_ne!(h.finish(), 0);
@@ -367,13 +382,7 @@ mod tests {
 
     #[test]
     fn meta_bits_are_independent() {
-        let mut n = Node {
-            state: (),
-            g: Cost::ZERO,
-            h: Cost::ZERO,
-            parent: NO_NODE,
-            meta: GOAL,
-        };
+        let mut n = Node { state: (), g: Cost::ZERO, h: Cost::ZERO, parent: NO_NODE, meta: GOAL };
         n.set_open(true);
         n.close(7);
         n.set_incons(true);

@@ -111,28 +111,16 @@ mod tests {
         for (key, h, node) in [(5, 0, 1), (3, 2, 7), (3, 1, 9), (3, 1, 4), (9, 0, 0)] {
             o.push(Entry { key, h, node });
         }
-        let order: Vec<_> = std::iter::from_fn(|| o.pop_valid(|_| true))
-            .map(|e| (e.key, e.h, e.node))
-            .collect();
-        assert_eq!(
-            order,
-            vec![(3, 1, 4), (3, 1, 9), (3, 2, 7), (5, 0, 1), (9, 0, 0)]
-        );
+        let order: Vec<_> =
+            std::iter::from_fn(|| o.pop_valid(|_| true)).map(|e| (e.key, e.h, e.node)).collect();
+        assert_eq!(order, vec![(3, 1, 4), (3, 1, 9), (3, 2, 7), (5, 0, 1), (9, 0, 0)]);
     }
 
     #[test]
     fn lazy_deletion_skips_stale() {
         let mut o = OpenList::new();
-        o.push(Entry {
-            key: 1,
-            h: 0,
-            node: 0,
-        });
-        o.push(Entry {
-            key: 2,
-            h: 0,
-            node: 1,
-        });
+        o.push(Entry { key: 1, h: 0, node: 0 });
+        o.push(Entry { key: 2, h: 0, node: 1 });
         assert_eq!(o.peek_valid(|e| e.node != 0).map(|e| e.node), Some(1));
         assert_eq!(o.len(), 1);
         assert_eq!(o.pop_valid(|e| e.node != 1), None);

@@ -116,12 +116,7 @@ impl SearchParams {
         }
         let decay = ((self.epsilon_decay * EPS_SCALE as f64).round() as u64).clamp(1, 999);
         let snap = (self.epsilon_snap.min(1e9) * EPS_SCALE as f64).round() as u64;
-        Ok(EpsilonSchedule {
-            initial,
-            final_,
-            decay,
-            snap,
-        })
+        Ok(EpsilonSchedule { initial, final_, decay, snap })
     }
 }
 
@@ -135,11 +130,7 @@ impl EpsilonSchedule {
         }
         let new_gap = (gap * self.decay + EPS_SCALE / 2) / EPS_SCALE;
         let new_gap = new_gap.min(gap - 1);
-        if new_gap < self.snap.max(1) {
-            self.final_
-        } else {
-            self.final_ + new_gap
-        }
+        if new_gap < self.snap.max(1) { self.final_ } else { self.final_ + new_gap }
     }
 }
 
@@ -161,10 +152,7 @@ mod tests {
             eps = s.next(eps);
             seen.push(eps);
         }
-        assert_eq!(
-            seen,
-            vec![3000, 2000, 1500, 1250, 1125, 1063, 1032, 1016, 1000]
-        );
+        assert_eq!(seen, vec![3000, 2000, 1500, 1250, 1125, 1063, 1032, 1016, 1000]);
     }
 
     #[test]
@@ -191,31 +179,12 @@ mod tests {
     fn invalid_params_are_rejected() {
         let bad = |p: SearchParams| p.validate().is_err();
         let d = SearchParams::default;
-        assert!(bad(SearchParams {
-            initial_epsilon: 0.5,
-            ..d()
-        }));
-        assert!(bad(SearchParams {
-            final_epsilon: f64::NAN,
-            ..d()
-        }));
-        assert!(bad(SearchParams {
-            initial_epsilon: 1.0,
-            final_epsilon: 2.0,
-            ..d()
-        }));
-        assert!(bad(SearchParams {
-            epsilon_decay: 1.0,
-            ..d()
-        }));
-        assert!(bad(SearchParams {
-            epsilon_decay: 0.0,
-            ..d()
-        }));
-        assert!(bad(SearchParams {
-            epsilon_snap: -1.0,
-            ..d()
-        }));
+        assert!(bad(SearchParams { initial_epsilon: 0.5, ..d() }));
+        assert!(bad(SearchParams { final_epsilon: f64::NAN, ..d() }));
+        assert!(bad(SearchParams { initial_epsilon: 1.0, final_epsilon: 2.0, ..d() }));
+        assert!(bad(SearchParams { epsilon_decay: 1.0, ..d() }));
+        assert!(bad(SearchParams { epsilon_decay: 0.0, ..d() }));
+        assert!(bad(SearchParams { epsilon_snap: -1.0, ..d() }));
         assert!(d().validate().is_ok());
     }
 }

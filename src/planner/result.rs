@@ -114,11 +114,7 @@ pub struct Hooks<'a, S> {
 
 impl<S> Default for Hooks<'_, S> {
     fn default() -> Self {
-        Self {
-            cancel: None,
-            on_expand: None,
-            on_solution: None,
-        }
+        Self { cancel: None, on_expand: None, on_solution: None }
     }
 }
 

@@ -42,11 +42,7 @@ const G: u8 = 3;
 /// S→A→G costs 6, S→B→G costs 4. h is consistent but badly underestimates at A, so
 /// weighted A* (ε = 3) takes the route through A; ARA* must then improve it.
 fn trap() -> Table {
-    Table {
-        edges: vec![(S, A, 1), (A, G, 5), (S, B, 3), (B, G, 1)],
-        h: vec![1, 0, 1, 0],
-        goal: G,
-    }
+    Table { edges: vec![(S, A, 1), (A, G, 5), (S, B, 3), (B, G, 1)], h: vec![1, 0, 1, 0], goal: G }
 }
 
 fn units(c: u64) -> Cost {
@@ -65,11 +61,7 @@ fn astar_finds_optimal_on_trap() {
 
 #[test]
 fn weighted_astar_is_suboptimal_on_trap() {
-    let p = SearchParams {
-        initial_epsilon: 3.0,
-        final_epsilon: 3.0,
-        ..SearchParams::default()
-    };
+    let p = SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
     let r = arastar(&mut trap(), S, &p).expect("valid params");
     assert_eq!(r.termination, Termination::FinalEpsilonReached);
     let best = r.best().expect("solution");
@@ -100,14 +92,7 @@ fn astar_reopens_for_inconsistent_admissible_heuristic() {
     // improves it to 4. Without re-opening A, the search would settle for S→C→G (15).
     const C: u8 = 4;
     let mut g = Table {
-        edges: vec![
-            (S, A, 6),
-            (S, B, 2),
-            (B, A, 2),
-            (A, G, 10),
-            (S, C, 15),
-            (C, G, 0),
-        ],
+        edges: vec![(S, A, 6), (S, B, 2), (B, A, 2), (A, G, 10), (S, C, 15), (C, G, 0)],
         h: vec![0, 0, 12, 0, 0],
         goal: G,
     };
@@ -121,10 +106,7 @@ fn astar_reopens_for_inconsistent_admissible_heuristic() {
 fn start_is_goal() {
     let mut g = trap();
     let r = astar(&mut g, G, &SearchParams::default());
-    assert_eq!(
-        r.best().map(|s| (s.path.clone(), s.cost)),
-        Some((vec![G], Cost::ZERO))
-    );
+    assert_eq!(r.best().map(|s| (s.path.clone(), s.cost)), Some((vec![G], Cost::ZERO)));
     let r = arastar(&mut g, G, &SearchParams::default()).expect("valid");
     assert_eq!(r.termination, Termination::OptimalProven);
     assert_eq!(r.solutions.len(), 1);
@@ -133,11 +115,7 @@ fn start_is_goal() {
 
 #[test]
 fn unreachable_goal_reports_no_path() {
-    let mut g = Table {
-        edges: vec![(S, A, 1), (A, S, 1), (B, G, 1)],
-        h: vec![0; 4],
-        goal: G,
-    };
+    let mut g = Table { edges: vec![(S, A, 1), (A, S, 1), (B, G, 1)], h: vec![0; 4], goal: G };
     let r = astar(&mut g, S, &SearchParams::default());
     assert_eq!(r.termination, Termination::NoPath);
     assert!(r.solutions.is_empty());
@@ -155,11 +133,7 @@ impl SearchGraph for WithInfinite {
     fn successors(&mut self, s: u8, out: &mut Vec<(u8, Cost)>) {
         for &(a, b, c) in &self.0 {
             if a == s {
-                let cost = if c == u64::MAX {
-                    Cost::INFINITY
-                } else {
-                    units(c)
-                };
+                let cost = if c == u64::MAX { Cost::INFINITY } else { units(c) };
                 out.push((b, cost));
             }
         }
@@ -176,10 +150,7 @@ impl SearchGraph for WithInfinite {
 fn infinite_edges_are_not_followed() {
     let mut g = WithInfinite(vec![(S, G, u64::MAX), (S, A, 2), (A, G, 2)]);
     let r = astar(&mut g, S, &SearchParams::default());
-    assert_eq!(
-        r.best().map(|s| (s.path.clone(), s.cost)),
-        Some((vec![S, A, G], units(4)))
-    );
+    assert_eq!(r.best().map(|s| (s.path.clone(), s.cost)), Some((vec![S, A, G], units(4))));
     let mut g = WithInfinite(vec![(S, G, u64::MAX)]);
     let r = arastar(&mut g, S, &SearchParams::default()).expect("valid");
     assert_eq!(r.termination, Termination::NoPath);
@@ -187,10 +158,7 @@ fn infinite_edges_are_not_followed() {
 
 #[test]
 fn invalid_params_are_an_error() {
-    let p = SearchParams {
-        initial_epsilon: 0.9,
-        ..SearchParams::default()
-    };
+    let p = SearchParams { initial_epsilon: 0.9, ..SearchParams::default() };
     assert!(matches!(
         arastar(&mut trap(), S, &p),
         Err(SearchError::Params(ParamsError::Epsilon { .. }))
@@ -200,28 +168,16 @@ fn invalid_params_are_an_error() {
 #[test]
 fn expansion_and_state_limits() {
     let mut g = Unbounded;
-    let p = SearchParams {
-        max_expansions: Some(100),
-        ..SearchParams::default()
-    };
+    let p = SearchParams { max_expansions: Some(100), ..SearchParams::default() };
     let r = astar(&mut g, (5, 0), &p);
     assert_eq!(r.termination, Termination::ExpansionLimit);
     assert_eq!(r.expansions, 100);
-    let p = SearchParams {
-        max_states: Some(50),
-        ..SearchParams::default()
-    };
+    let p = SearchParams { max_states: Some(50), ..SearchParams::default() };
     let r = arastar(&mut g, (5, 0), &p).expect("valid");
     assert_eq!(r.termination, Termination::StateLimit);
     assert!(r.states <= 50);
-    let p = SearchParams {
-        max_states: Some(0),
-        ..SearchParams::default()
-    };
-    assert_eq!(
-        astar(&mut g, (5, 0), &p).termination,
-        Termination::StateLimit
-    );
+    let p = SearchParams { max_states: Some(0), ..SearchParams::default() };
+    assert_eq!(astar(&mut g, (5, 0), &p).termination, Termination::StateLimit);
 }
 
 #[test]
@@ -230,17 +186,10 @@ fn hooks_see_every_expansion_and_solution() {
     let mut log = |e: &Expansion<u8>| expanded.push((e.state, e.iteration));
     let mut found = Vec::new();
     let mut on_sol = |s: &Solution<u8>| found.push(s.cost);
-    let hooks = Hooks {
-        cancel: None,
-        on_expand: Some(&mut log),
-        on_solution: Some(&mut on_sol),
-    };
+    let hooks = Hooks { cancel: None, on_expand: Some(&mut log), on_solution: Some(&mut on_sol) };
     let r = arastar_with_hooks(&mut trap(), S, &SearchParams::default(), hooks).expect("valid");
     assert_eq!(expanded, vec![(S, 0), (A, 0), (B, 1)]);
-    assert_eq!(
-        found,
-        r.solutions.iter().map(|s| s.cost).collect::<Vec<_>>()
-    );
+    assert_eq!(found, r.solutions.iter().map(|s| s.cost).collect::<Vec<_>>());
 }
 
 // ---------------------------------------------------------------- grids
@@ -259,16 +208,8 @@ struct Grid {
 
 const STRAIGHT: u64 = Cost::SCALE;
 const DIAGONAL: u64 = 1_414_214; // round(√2 · 10⁶)
-const DIRS8: [(i32, i32); 8] = [
-    (1, 0),
-    (1, 1),
-    (0, 1),
-    (-1, 1),
-    (-1, 0),
-    (-1, -1),
-    (0, -1),
-    (1, -1),
-];
+const DIRS8: [(i32, i32); 8] =
+    [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)];
 
 fn octile(a: (i64, i64), b: (i64, i64)) -> Cost {
     let (dx, dy) = ((a.0 - b.0).unsigned_abs(), (a.1 - b.1).unsigned_abs());
@@ -291,21 +232,14 @@ impl SearchGraph for Grid {
         let Some(here) = self.cell(x, y) else { return };
         for (dx, dy) in DIRS8 {
             if let Some(there) = self.cell(x + dx, y + dy) {
-                let len = if dx != 0 && dy != 0 {
-                    DIAGONAL
-                } else {
-                    STRAIGHT
-                };
+                let len = if dx != 0 && dy != 0 { DIAGONAL } else { STRAIGHT };
                 let c = len * (u64::from(here) + u64::from(there)) / 2;
                 out.push(((x + dx, y + dy), Cost(c)));
             }
         }
     }
     fn heuristic(&self, (x, y): (i32, i32)) -> Cost {
-        octile(
-            (x.into(), y.into()),
-            (self.goal.0.into(), self.goal.1.into()),
-        )
+        octile((x.into(), y.into()), (self.goal.0.into(), self.goal.1.into()))
     }
     fn is_goal(&self, s: (i32, i32)) -> bool {
         s == self.goal
@@ -354,11 +288,7 @@ where
     for w in sol.path.windows(2) {
         out.clear();
         g.successors(w[0], &mut out);
-        let edge = out
-            .iter()
-            .filter(|(s, _)| *s == w[1])
-            .map(|&(_, c)| c)
-            .min();
+        let edge = out.iter().filter(|(s, _)| *s == w[1]).map(|&(_, c)| c).min();
         assert!(edge.is_some(), "{:?} -> {:?} is not an edge", w[0], w[1]);
         total += edge.unwrap_or(Cost::INFINITY);
     }
@@ -383,22 +313,13 @@ fn grid_strategy() -> impl Strategy<Value = (Grid, (i32, i32))> {
             cells[s] = cells[s].or(Some(1));
             cells[g] = cells[g].or(Some(1));
             let at = |i: usize| (i as i32 % w, i as i32 / w);
-            let grid = Grid {
-                w,
-                h,
-                cells,
-                goal: at(g),
-            };
+            let grid = Grid { w, h, cells, goal: at(g) };
             (grid, at(s))
         })
 }
 
 fn eps_params(initial: f64, decay: f64) -> SearchParams {
-    SearchParams {
-        initial_epsilon: initial,
-        epsilon_decay: decay,
-        ..SearchParams::default()
-    }
+    SearchParams { initial_epsilon: initial, epsilon_decay: decay, ..SearchParams::default() }
 }
 
 proptest! {
@@ -489,19 +410,10 @@ fn fixed_grid() -> Grid {
             x ^= x << 13;
             x ^= x >> 7;
             x ^= x << 17;
-            if x.is_multiple_of(5) {
-                None
-            } else {
-                Some((x % 7 + 1) as u8)
-            }
+            if x.is_multiple_of(5) { None } else { Some((x % 7 + 1) as u8) }
         })
         .collect::<Vec<_>>();
-    let mut grid = Grid {
-        w,
-        h,
-        cells,
-        goal: (w - 1, h - 1),
-    };
+    let mut grid = Grid { w, h, cells, goal: (w - 1, h - 1) };
     grid.cells[0] = Some(1);
     let last = grid.cells.len() - 1;
     grid.cells[last] = Some(1);
@@ -514,24 +426,13 @@ fn same_graph_same_paths() {
         let mut g = fixed_grid();
         let r = arastar(&mut g, (0, 0), &SearchParams::default()).expect("valid");
         let a = astar(&mut g, (0, 0), &SearchParams::default());
-        let sols: Vec<_> = r
-            .solutions
-            .into_iter()
-            .map(|s| (s.path, s.cost, s.epsilon, s.expansions))
-            .collect();
-        (
-            sols,
-            a.best().map(|s| s.path.clone()),
-            r.expansions,
-            a.expansions,
-        )
+        let sols: Vec<_> =
+            r.solutions.into_iter().map(|s| (s.path, s.cost, s.epsilon, s.expansions)).collect();
+        (sols, a.best().map(|s| s.path.clone()), r.expansions, a.expansions)
     };
     let first = run();
     assert!(!first.0.is_empty(), "fixed grid must be solvable");
-    assert!(
-        first.0.len() > 1,
-        "ARA* should improve at least once on the fixed grid"
-    );
+    assert!(first.0.len() > 1, "ARA* should improve at least once on the fixed grid");
     assert_eq!(first, run());
 }
 
@@ -594,25 +495,15 @@ fn cancel_flag_stops_search() {
             std::thread::sleep(Duration::from_millis(100));
             flag.store(true, Ordering::Relaxed);
         });
-        let hooks = Hooks {
-            cancel: Some(&flag),
-            ..Hooks::default()
-        };
+        let hooks = Hooks { cancel: Some(&flag), ..Hooks::default() };
         arastar_with_hooks(&mut Unbounded, (5, 3), &p, hooks).expect("valid")
     });
     assert_eq!(r.termination, Termination::Cancelled);
     assert!(r.expansions > 0);
-    assert!(
-        t.elapsed() < Duration::from_secs(2),
-        "took {:?}",
-        t.elapsed()
-    );
+    assert!(t.elapsed() < Duration::from_secs(2), "took {:?}", t.elapsed());
 
     // Already raised: stops before the first expansion.
-    let hooks = Hooks {
-        cancel: Some(&flag),
-        ..Hooks::default()
-    };
+    let hooks = Hooks { cancel: Some(&flag), ..Hooks::default() };
     let r = astar_with_hooks(&mut Unbounded, (5, 3), &p, hooks);
     assert_eq!(r.termination, Termination::Cancelled);
     assert_eq!(r.expansions, 0);
@@ -623,14 +514,69 @@ fn time_limit_keeps_anytime_solutions() {
     // A limit that ends ARA* somewhere in its iterations still returns what it found,
     // with non-increasing costs, and the termination is the limit or optimality.
     let mut g = fixed_grid();
-    let p = SearchParams {
-        time_limit: Some(Duration::from_millis(5)),
-        ..SearchParams::default()
-    };
+    let p = SearchParams { time_limit: Some(Duration::from_millis(5)), ..SearchParams::default() };
     let r = arastar(&mut g, (0, 0), &p).expect("valid");
-    assert!(matches!(
-        r.termination,
-        Termination::TimeLimit | Termination::OptimalProven
-    ));
+    assert!(matches!(r.termination, Termination::TimeLimit | Termination::OptimalProven));
     assert!(r.solutions.windows(2).all(|w| w[1].cost <= w[0].cost));
+}
+
+/// A graph that offers dense indices for half of its states must give exactly the same
+/// search as without them (the index is only a faster look-up).
+mod dense_index {
+    use crate::planner::{Cost, SearchGraph, SearchParams, arastar, astar};
+
+    struct Grid {
+        n: i32,
+        dense: bool,
+    }
+
+    impl SearchGraph for Grid {
+        type State = (i32, i32);
+        fn successors(&mut self, (x, y): (i32, i32), out: &mut Vec<((i32, i32), Cost)>) {
+            for (dx, dy) in [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, -1)] {
+                let (a, b) = (x + dx, y + dy);
+                if a >= 0 && b >= 0 && a < self.n && b < self.n && (a * 7 + b * 3) % 11 != 0 {
+                    let w = 1 + ((a * 13 + b * 5) % 4) as u64;
+                    out.push(((a, b), Cost(w * Cost::SCALE)));
+                }
+            }
+        }
+        fn heuristic(&self, (x, y): (i32, i32)) -> Cost {
+            let d = (self.n - 1 - x).max(self.n - 1 - y).max(0) as u64;
+            Cost(d * Cost::SCALE)
+        }
+        fn is_goal(&self, s: (i32, i32)) -> bool {
+            s == (self.n - 1, self.n - 1)
+        }
+        fn dense_len(&self) -> usize {
+            if self.dense { (self.n * self.n) as usize } else { 0 }
+        }
+        fn dense_index(&self, (x, y): (i32, i32)) -> Option<usize> {
+            // Only even rows are indexed: the rest go through the hash map.
+            (self.dense && y % 2 == 0).then_some((y * self.n + x) as usize)
+        }
+    }
+
+    #[test]
+    fn dense_and_hashed_searches_agree() {
+        for n in [5, 17, 40] {
+            let a = astar(&mut Grid { n, dense: true }, (0, 0), &SearchParams::default());
+            let b = astar(&mut Grid { n, dense: false }, (0, 0), &SearchParams::default());
+            assert_eq!(
+                a.solutions,
+                b.solutions
+                    .iter()
+                    .map(|s| crate::planner::Solution { time: a.solutions[0].time, ..s.clone() })
+                    .collect::<Vec<_>>()
+            );
+            assert_eq!((a.expansions, a.states), (b.expansions, b.states));
+            let p = SearchParams::default();
+            let c = arastar(&mut Grid { n, dense: true }, (0, 0), &p).expect("params");
+            let d = arastar(&mut Grid { n, dense: false }, (0, 0), &p).expect("params");
+            let costs = |r: &crate::planner::SearchResult<(i32, i32)>| {
+                r.solutions.iter().map(|s| (s.cost, s.path.clone())).collect::<Vec<_>>()
+            };
+            assert_eq!(costs(&c), costs(&d));
+        }
+    }
 }

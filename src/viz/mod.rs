@@ -8,6 +8,7 @@
 //! - `world/plan/...` and `maps/...`: plans and cost layers, where a job logs them.
 
 use crate::cost_image::RgbImage;
+use crate::geometry::Pose2;
 use crate::monitor::StabilitySample;
 use crate::sim::{BodyPose, GeomKind, GeomShape};
 use crate::terrain::HeightMap;
@@ -66,6 +67,10 @@ impl Recorder {
     /// # Errors
     /// [`VizError::Write`] if the file cannot be created.
     pub fn create(path: &Path, app: &'static str) -> Result<Self, VizError> {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| VizError::Write { path: path.to_owned(), message: e.to_string() })?;
+        }
         let rec = rerun::RecordingStreamBuilder::new(app)
             .save(path)
             .map_err(|e| VizError::Write { path: path.to_owned(), message: e.to_string() })?;
@@ -293,6 +298,77 @@ impl Recorder {
         );
         self.rec
             .log_static(format!("maps/{name}/info"), &rerun::TextDocument::new(text))
+            .map_err(|e| self.err(e))
+    }
+
+    /// Logs a planned driving path as a static line strip (base positions, 2 cm above the
+    /// ground) with heading arrows every tenth pose, under `world/plan`.
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_plan(&self, poses: &[Pose2]) -> Result<(), VizError> {
+        let line: Vec<[f32; 3]> = poses.iter().map(|p| [p.x as f32, p.y as f32, 0.02]).collect();
+        self.rec
+            .log_static(
+                "world/plan/path",
+                &rerun::LineStrips3D::new([line])
+                    .with_colors([rerun::Color::from_rgb(40, 90, 230)]),
+            )
+            .map_err(|e| self.err(e))?;
+        let (origins, vectors): (Vec<[f32; 3]>, Vec<[f32; 3]>) = poses
+            .iter()
+            .step_by(10)
+            .map(|p| {
+                (
+                    [p.x as f32, p.y as f32, 0.02],
+                    [0.1 * p.theta.cos() as f32, 0.1 * p.theta.sin() as f32, 0.0],
+                )
+            })
+            .unzip();
+        self.rec
+            .log_static(
+                "world/plan/headings",
+                &rerun::Arrows3D::from_vectors(vectors).with_origins(origins),
+            )
+            .map_err(|e| self.err(e))
+    }
+
+    /// Logs abstract steps as static lines from the old foot position to the foothold, front
+    /// steps red and rear steps green (paper Fig. 11), under `world/plan/steps`.
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_steps(&self, steps: &[([f64; 3], [f64; 3], bool)]) -> Result<(), VizError> {
+        let lines: Vec<Vec<[f32; 3]>> =
+            steps.iter().map(|(a, b, _)| vec![v3(*a), v3(*b)]).collect();
+        let colors: Vec<rerun::Color> = steps
+            .iter()
+            .map(|(_, _, front)| {
+                if *front {
+                    rerun::Color::from_rgb(220, 40, 40)
+                } else {
+                    rerun::Color::from_rgb(40, 180, 60)
+                }
+            })
+            .collect();
+        self.rec
+            .log_static("world/plan/steps", &rerun::LineStrips3D::new(lines).with_colors(colors))
+            .map_err(|e| self.err(e))
+    }
+
+    /// Appends the base position to the executed trajectory (`world/trajectory`).
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_trajectory_point(&self, time: f64, position: [f64; 3]) -> Result<(), VizError> {
+        self.rec.set_duration_secs(SIM_TIME, time);
+        self.rec
+            .log(
+                "world/trajectory",
+                &rerun::Points3D::new([v3(position)])
+                    .with_radii([0.01])
+                    .with_colors([rerun::Color::from_rgb(230, 120, 20)]),
+            )
             .map_err(|e| self.err(e))
     }
 

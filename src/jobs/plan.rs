@@ -1,0 +1,737 @@
+//! `momaro plan` and `momaro bench`: the hybrid driving-stepping planner (Klamt & Behnke
+//! 2017, Sec. V, VII) run on a scenario, as library functions returning serialisable
+//! summaries.
+//!
+//! [`run`] rasterises the scenario's terrain to a height map (2.5 cm), builds the cost
+//! maps (Sec. IV), checks the start and goal poses, and searches the hybrid graph
+//! (`locomotion::hybrid`) with A* (16-neighbourhood) or ARA* (20-neighbourhood, ε from
+//! 3 decaying to 1), as the paper does. The time limit covers everything after option
+//! checking: map and cost-map building count against it, and the search gets what is
+//! left, so a call never takes much longer than the limit.
+//!
+//! Path costs are reported twice: `search_cost` as searched (with the orientation factor
+//! k_Δθ of the chosen k12) and `cost`, "the costs the path would have in the plain A*
+//! planner" (Sec. VIII): every edge re-evaluated with k12 = 1, so variants with different
+//! k12 compare.
+//!
+//! [`bench()`] measures the anytime behaviour the paper reports (Sec. VIII): time to the
+//! first solution, its cost over the optimum, the cost reached after 1 s and 10 s, and
+//! the time to the optimal solution, for A* and for ARA*.
+
+use crate::cost::{Cost as CostValue, CostError, CostMaps};
+use crate::geometry::Pose2;
+use crate::locomotion::{
+    Algorithm, DrivingGoal, HybridConfig, HybridGraph, LatticeError, LatticeState, ManoeuvreKind,
+    Neighbourhood, StepCost,
+};
+use crate::params::{InvalidParam, Params};
+use crate::planner::{
+    Cost, Hooks, SearchError, SearchParams, SearchResult, Termination, arastar_with_hooks,
+    astar_with_hooks,
+};
+use crate::robot::{Leg, RobotDescription};
+use crate::scenario::Scenario;
+use crate::terrain::{RasteriseError, rasterise};
+use serde::Serialize;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+/// Options of a plan job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanOptions {
+    /// A* or ARA*.
+    pub algorithm: Algorithm,
+    /// Wall-clock budget for the whole job (maps and search), s.
+    pub time_limit_s: f64,
+    /// ARA*'s initial heuristic weight; default `Params::arastar_initial_epsilon` (3.0).
+    pub initial_epsilon: Option<f64>,
+    /// Orientation cost factor k12 (Sec. VII-A); default the scenario's (2.0).
+    pub k12: Option<f64>,
+    /// Step-related cost factor; default the scenario's (`Params::step_cost_factor`).
+    pub step_cost_factor: Option<f64>,
+    /// Driving neighbourhood; default N16 for A*, N20 for ARA* (Sec. VII-B).
+    pub neighbourhood: Option<Neighbourhood>,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self {
+            algorithm: Algorithm::AraStar,
+            time_limit_s: 10.0,
+            initial_epsilon: None,
+            k12: None,
+            step_cost_factor: None,
+            neighbourhood: None,
+        }
+    }
+}
+
+/// Why a plan job failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanJobError {
+    /// An option is out of range.
+    #[error("invalid option `{option}`: {reason}")]
+    BadOption {
+        /// The option.
+        option: &'static str,
+        /// Why.
+        reason: String,
+    },
+    /// A parameter (after the options' overrides) is invalid.
+    #[error("scenario {scenario}: {source}")]
+    Params {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// The parameter.
+        source: InvalidParam,
+    },
+    /// The height map could not be built.
+    #[error("scenario {scenario}: cannot build the height map: {source}")]
+    Map {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// The cause.
+        source: RasteriseError,
+    },
+    /// The cost maps could not be built.
+    #[error("scenario {scenario}: cannot build the cost maps: {source}")]
+    Cost {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// The cause.
+        source: CostError,
+    },
+    /// The map is too large for the lattice.
+    #[error("scenario {scenario}: {source}")]
+    Lattice {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// The cause.
+        source: LatticeError,
+    },
+    /// The start or goal pose lies off the map.
+    #[error(
+        "scenario {scenario}: the {which} pose ({x:.3}, {y:.3}) lies off the map [{x_min}, {x_max}] x [{y_min}, {y_max}]",
+        x = pose.x, y = pose.y, x_min = bounds[0], y_min = bounds[1], x_max = bounds[2], y_max = bounds[3]
+    )]
+    OffMap {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// `start` or `goal`.
+        which: &'static str,
+        /// The pose.
+        pose: Pose2,
+        /// Map bounds `[x_min, y_min, x_max, y_max]`, m.
+        bounds: [f64; 4],
+    },
+    /// The robot cannot stand at the start or goal pose in its driving footprint.
+    #[error(
+        "scenario {scenario}: the {which} pose ({x:.3}, {y:.3}, {yaw:.1}°) is untraversable: {reason}",
+        x = pose.x, y = pose.y, yaw = pose.theta.to_degrees()
+    )]
+    Untraversable {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// `start` or `goal`.
+        which: &'static str,
+        /// The pose.
+        pose: Pose2,
+        /// Why (a foot in an infinite-cost cell, unknown terrain).
+        reason: &'static str,
+    },
+    /// The search ended without a path.
+    #[error("scenario {scenario}: no path from start to goal: {reason}")]
+    NoPath {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// Why the search ended.
+        termination: Termination,
+        /// What that means.
+        reason: String,
+    },
+    /// The search could not start.
+    #[error("scenario {scenario}: {source}")]
+    Search {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// The cause.
+        source: SearchError,
+    },
+}
+
+/// One solution of the search, as the anytime planner delivered it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SolutionSummary {
+    /// Heuristic weight ε of the search that found it (1 for A*).
+    pub epsilon: f64,
+    /// Plain A* cost of the path (every edge with k12 = 1, Sec. VIII).
+    pub cost: f64,
+    /// Cost as searched (with the chosen k12).
+    pub search_cost: f64,
+    /// Proven bound on cost / optimum (1 = optimal).
+    pub suboptimality_bound: f64,
+    /// Time from the start of the search, s.
+    pub time_s: f64,
+    /// Expansions from the start of the search.
+    pub expansions: u64,
+}
+
+/// What a path element does (the manoeuvre that leads to its pose; `start` first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PathKind {
+    /// The start pose.
+    Start,
+    /// A straight driving move.
+    Drive,
+    /// A turn on the spot.
+    Turn,
+    /// An abstract step.
+    Step,
+    /// A longitudinal base shift.
+    BaseShift,
+    /// A front wheel pair driven forward.
+    FootForward,
+    /// A wheel pair driven back to neutral.
+    FootNeutral,
+}
+
+impl From<ManoeuvreKind> for PathKind {
+    fn from(k: ManoeuvreKind) -> Self {
+        match k {
+            ManoeuvreKind::Drive => PathKind::Drive,
+            ManoeuvreKind::Turn => PathKind::Turn,
+            ManoeuvreKind::Step => PathKind::Step,
+            ManoeuvreKind::BaseShift => PathKind::BaseShift,
+            ManoeuvreKind::FootForward => PathKind::FootForward,
+            ManoeuvreKind::FootNeutral => PathKind::FootNeutral,
+        }
+    }
+}
+
+/// One pose of the planned path and the manoeuvre that reached it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PathElement {
+    /// The manoeuvre.
+    pub kind: PathKind,
+    /// The leg that moved (steps and foot moves).
+    pub leg: Option<Leg>,
+    /// Base pose after the manoeuvre (lattice cell centre and orientation).
+    pub pose: Pose2,
+    /// World (x, y) of the feet, FL, FR, RL, RR.
+    pub feet: [[f64; 2]; 4],
+    /// Ground height under each foot, m (`null` where unknown).
+    pub foot_heights: [Option<f64>; 4],
+    /// Foot offsets from the neutral footprint along the base's x', m.
+    pub foot_offsets_m: [f64; 4],
+    /// Plain A* cost of the manoeuvre (k12 = 1).
+    pub cost: f64,
+    /// The parts of C_S (eq. 5), for steps.
+    pub step: Option<StepCost>,
+}
+
+/// Grid of the plan.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MapInfo {
+    /// World position of the corner of cell (0, 0), m.
+    pub origin: [f64; 2],
+    /// Cell size, m.
+    pub resolution: f64,
+    /// Cells along x.
+    pub nx: usize,
+    /// Cells along y.
+    pub ny: usize,
+    /// Orientations per cell.
+    pub orientations: u32,
+}
+
+/// The result of a plan job: everything `momaro plan --json` prints.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlanSummary {
+    /// Scenario name.
+    pub scenario: String,
+    /// `astar` or `arastar`.
+    pub algorithm: &'static str,
+    /// Every solution in the order found (costs never increase).
+    pub solutions: Vec<SolutionSummary>,
+    /// The best path, start first.
+    pub path: Vec<PathElement>,
+    /// Plain A* cost of the best path (k12 = 1, Sec. VIII).
+    pub cost: f64,
+    /// Cost of the best path as searched.
+    pub search_cost: f64,
+    /// Number of abstract steps on the path.
+    pub steps: usize,
+    /// Search time, s.
+    pub planning_time_s: f64,
+    /// Height-map and cost-map building time, s.
+    pub setup_time_s: f64,
+    /// Why the search stopped: `optimal_proven`, `time_limit`, ...
+    pub termination: &'static str,
+    /// Expansions, all iterations.
+    pub expansions: u64,
+    /// States generated.
+    pub states: usize,
+    /// Distinct footprints met.
+    pub footprints: usize,
+    /// The step-related factor used.
+    pub step_cost_factor: f64,
+    /// k12 used.
+    pub k12: f64,
+    /// The grid.
+    pub map: MapInfo,
+}
+
+/// Snake-case name of a termination.
+pub fn termination_name(t: Termination) -> &'static str {
+    match t {
+        Termination::OptimalProven => "optimal_proven",
+        Termination::FinalEpsilonReached => "final_epsilon_reached",
+        Termination::TimeLimit => "time_limit",
+        Termination::Cancelled => "cancelled",
+        Termination::NoPath => "no_path",
+        Termination::ExpansionLimit => "expansion_limit",
+        Termination::StateLimit => "state_limit",
+    }
+}
+
+fn algorithm_name(a: Algorithm) -> &'static str {
+    match a {
+        Algorithm::AStar => "astar",
+        Algorithm::AraStar => "arastar",
+    }
+}
+
+/// Cost maps, lattice states of start and goal and the parameters of one scenario: what
+/// every search of a job shares.
+pub struct Prepared {
+    /// The parameters with the options' overrides.
+    pub params: Params,
+    /// The cost client.
+    pub maps: CostMaps,
+    /// Start state (neutral footprint).
+    pub start: LatticeState,
+    /// Goal state (neutral footprint).
+    pub goal: LatticeState,
+    /// Time spent building, s.
+    pub setup_time_s: f64,
+}
+
+fn bad(option: &'static str, reason: impl Into<String>) -> PlanJobError {
+    PlanJobError::BadOption { option, reason: reason.into() }
+}
+
+/// Builds the height map and cost maps of `scenario` and checks its start and goal.
+///
+/// # Errors
+/// Invalid parameters, an unbuildable map, or a start / goal off the map or on
+/// untraversable terrain.
+pub fn prepare(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    k12: Option<f64>,
+    step_cost_factor: Option<f64>,
+) -> Result<Prepared, PlanJobError> {
+    let t0 = Instant::now();
+    let file = || scenario.path.clone();
+    let mut params = scenario.params.clone();
+    if let Some(k) = k12 {
+        params.k12 = k;
+    }
+    if let Some(f) = step_cost_factor {
+        params.step_cost_factor = f;
+    }
+    params.validate().map_err(|source| PlanJobError::Params { scenario: file(), source })?;
+    let m = &scenario.map;
+    let heights = rasterise(
+        &scenario.terrain,
+        [m.x_min, m.y_min],
+        [m.x_max - m.x_min, m.y_max - m.y_min],
+        params.grid_resolution_m,
+    )
+    .map_err(|source| PlanJobError::Map { scenario: file(), source })?;
+    let maps = CostMaps::build(&heights, robot, &params)
+        .map_err(|source| PlanJobError::Cost { scenario: file(), source })?;
+    let lattice = crate::locomotion::Lattice::for_map(maps.heights(), params.orientations)
+        .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
+    let mut states = [LatticeState::new(0, 0, 0); 2];
+    for (k, (which, pose)) in
+        [("start", scenario.start), ("goal", scenario.goal)].into_iter().enumerate()
+    {
+        let Some(s) = lattice.state(&pose) else {
+            return Err(PlanJobError::OffMap {
+                scenario: file(),
+                which,
+                pose,
+                bounds: maps.heights().bounds(),
+            });
+        };
+        let reason = match maps.driving_pose_cost(&lattice.pose(s)) {
+            CostValue::Finite(_) => None,
+            CostValue::Infinite => Some(
+                "a wheel stands on or next to an untraversable height difference (infinite foot cost)",
+            ),
+            CostValue::Unknown => {
+                Some("the robot stands on unknown terrain or reaches off the map")
+            }
+        };
+        if let Some(reason) = reason {
+            return Err(PlanJobError::Untraversable { scenario: file(), which, pose, reason });
+        }
+        states[k] = s;
+    }
+    Ok(Prepared {
+        params,
+        maps,
+        start: states[0],
+        goal: states[1],
+        setup_time_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+impl Prepared {
+    /// The hybrid graph for this scenario with `neighbourhood` and k12 = `k12`.
+    ///
+    /// # Errors
+    /// A map too large for the lattice.
+    pub fn graph(
+        &self,
+        robot: &RobotDescription,
+        neighbourhood: Neighbourhood,
+        k12: f64,
+    ) -> Result<HybridGraph<'_>, LatticeError> {
+        let params = Params { k12, ..self.params.clone() };
+        let config = HybridConfig::new(&params, robot, neighbourhood);
+        HybridGraph::new(
+            &self.maps,
+            robot,
+            self.params.orientations,
+            config,
+            DrivingGoal::at(self.goal),
+        )
+    }
+
+    /// The map grid.
+    pub fn map_info(&self) -> MapInfo {
+        let hm = self.maps.heights();
+        let (nx, ny) = hm.dims();
+        MapInfo {
+            origin: hm.origin(),
+            resolution: hm.resolution(),
+            nx,
+            ny,
+            orientations: self.params.orientations,
+        }
+    }
+}
+
+/// Runs one search on `graph`.
+fn search(
+    graph: &mut HybridGraph<'_>,
+    start: LatticeState,
+    algorithm: Algorithm,
+    params: &SearchParams,
+    cancel: Option<&AtomicBool>,
+) -> Result<SearchResult<LatticeState>, SearchError> {
+    let hooks = Hooks { cancel, ..Hooks::default() };
+    Ok(match algorithm {
+        Algorithm::AStar => astar_with_hooks(graph, start, params, hooks),
+        Algorithm::AraStar => arastar_with_hooks(graph, start, params, hooks)?,
+    })
+}
+
+fn default_neighbourhood(a: Algorithm) -> Neighbourhood {
+    match a {
+        Algorithm::AStar => Neighbourhood::N16,
+        Algorithm::AraStar => Neighbourhood::N20,
+    }
+}
+
+fn check_time(option: &'static str, t: f64) -> Result<Duration, PlanJobError> {
+    if t.is_finite() && t > 0.0 && t < 1e7 {
+        Ok(Duration::from_secs_f64(t))
+    } else {
+        Err(bad(option, format!("{t} must be a number of seconds > 0")))
+    }
+}
+
+/// The plain A* cost (k12 = 1, Sec. VIII) of a path of `graph`, per edge; `plain` is
+/// the graph with k12 = 1 and the 20-neighbourhood (which holds every move of either
+/// search). States move to `plain` by their foot offsets (footprint ids are per graph).
+fn plain_edge_costs(
+    graph: &HybridGraph<'_>,
+    plain: &mut HybridGraph<'_>,
+    path: &[LatticeState],
+) -> Vec<Cost> {
+    let mut states = Vec::with_capacity(path.len());
+    for &s in path {
+        let t = graph.offsets(s).and_then(|o| plain.with_offsets(s, o));
+        states.push(t);
+    }
+    states
+        .windows(2)
+        .map(|w| match (w[0], w[1]) {
+            (Some(a), Some(b)) => plain.edge(a, b).map_or(Cost::INFINITY, |(c, _)| c),
+            _ => Cost::INFINITY,
+        })
+        .collect()
+}
+
+/// Plans a path for `scenario` (see the module docs).
+///
+/// # Errors
+/// [`PlanJobError`]: bad options, an unbuildable map, a start or goal off the map or on
+/// untraversable terrain, or no path found (none exists, or none within the time limit).
+pub fn run(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    opts: &PlanOptions,
+) -> Result<PlanSummary, PlanJobError> {
+    let limit = check_time("time_limit_s", opts.time_limit_s)?;
+    if let Some(e) = opts.initial_epsilon
+        && !(e.is_finite() && e >= 1.0)
+    {
+        return Err(bad("initial_epsilon", format!("{e} must be at least 1")));
+    }
+    if let Some(k) = opts.k12
+        && !(k.is_finite() && k >= 1.0)
+    {
+        return Err(bad("k12", format!("{k} must be at least 1")));
+    }
+    let t0 = Instant::now();
+    let file = || scenario.path.clone();
+    let prep = prepare(scenario, robot, opts.k12, opts.step_cost_factor)?;
+    let neighbourhood = opts.neighbourhood.unwrap_or_else(|| default_neighbourhood(opts.algorithm));
+    let lattice_err = |source| PlanJobError::Lattice { scenario: file(), source };
+    let mut graph = prep.graph(robot, neighbourhood, prep.params.k12).map_err(lattice_err)?;
+    let eps0 = opts.initial_epsilon.unwrap_or(prep.params.arastar_initial_epsilon);
+    let search_params = SearchParams {
+        initial_epsilon: eps0,
+        epsilon_decay: prep.params.arastar_epsilon_decay,
+        time_limit: Some(limit.saturating_sub(t0.elapsed())),
+        ..SearchParams::default()
+    };
+    let result = search(&mut graph, prep.start, opts.algorithm, &search_params, None)
+        .map_err(|source| PlanJobError::Search { scenario: file(), source })?;
+    let Some(best) = result.best() else {
+        let reason = match result.termination {
+            Termination::NoPath => {
+                "the goal cannot be reached: every reachable pose has been searched".to_owned()
+            }
+            Termination::TimeLimit => format!(
+                "none found within the time limit of {} s ({} expansions)",
+                opts.time_limit_s, result.expansions
+            ),
+            t => format!("the search stopped ({})", termination_name(t)),
+        };
+        return Err(PlanJobError::NoPath {
+            scenario: file(),
+            termination: result.termination,
+            reason,
+        });
+    };
+
+    let mut plain = prep.graph(robot, Neighbourhood::N20, 1.0).map_err(lattice_err)?;
+    let plain_total = |costs: &[Cost]| costs.iter().copied().sum::<Cost>().to_f64();
+    let solutions = result
+        .solutions
+        .iter()
+        .map(|s| SolutionSummary {
+            epsilon: s.epsilon,
+            cost: plain_total(&plain_edge_costs(&graph, &mut plain, &s.path)),
+            search_cost: s.cost.to_f64(),
+            suboptimality_bound: s.suboptimality_bound,
+            time_s: s.time.as_secs_f64(),
+            expansions: s.expansions,
+        })
+        .collect();
+    let plain_costs = plain_edge_costs(&graph, &mut plain, &best.path);
+    let path = describe_path(&mut graph, &best.path, &plain_costs);
+    let steps = path.iter().filter(|e| e.kind == PathKind::Step).count();
+    Ok(PlanSummary {
+        scenario: scenario.name.clone(),
+        algorithm: algorithm_name(opts.algorithm),
+        solutions,
+        path,
+        cost: plain_total(&plain_costs),
+        search_cost: best.cost.to_f64(),
+        steps,
+        planning_time_s: result.elapsed.as_secs_f64(),
+        setup_time_s: prep.setup_time_s,
+        termination: termination_name(result.termination),
+        expansions: result.expansions,
+        states: result.states,
+        footprints: graph.footprint_count(),
+        step_cost_factor: prep.params.step_cost_factor,
+        k12: prep.params.k12,
+        map: prep.map_info(),
+    })
+}
+
+/// The path's elements: each state with the manoeuvre that reached it.
+fn describe_path(
+    graph: &mut HybridGraph<'_>,
+    path: &[LatticeState],
+    plain_costs: &[Cost],
+) -> Vec<PathElement> {
+    let res = graph.lattice().resolution;
+    let mut out = Vec::with_capacity(path.len());
+    for (k, &s) in path.iter().enumerate() {
+        let label = if k == 0 { None } else { graph.edge(path[k - 1], s).map(|(_, m)| m) };
+        let feet = graph.feet(s).unwrap_or([[f64::NAN; 2]; 4]);
+        let offsets = graph.offsets(s).unwrap_or([0; 4]);
+        out.push(PathElement {
+            kind: label.map_or(PathKind::Start, |m| m.kind.into()),
+            leg: label.and_then(|m| m.leg),
+            pose: graph.pose(s),
+            feet,
+            foot_heights: feet.map(|[x, y]| graph_height(graph, x, y)),
+            foot_offsets_m: offsets.map(|o| f64::from(o) * res),
+            cost: if k == 0 {
+                0.0
+            } else {
+                plain_costs.get(k - 1).map_or(f64::INFINITY, |c| c.to_f64())
+            },
+            step: label.and_then(|m| m.step),
+        });
+    }
+    out
+}
+
+fn graph_height(graph: &HybridGraph<'_>, x: f64, y: f64) -> Option<f64> {
+    graph.height_at(x, y)
+}
+
+/// Options of a benchmark.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenchOptions {
+    /// Budget of the ARA* run, s (its anytime curve; ≥ 10 to report the 10 s cost).
+    pub arastar_time_limit_s: f64,
+    /// Budget of the A* runs that establish the optimum, s.
+    pub optimum_time_limit_s: f64,
+    /// k12; default the scenario's.
+    pub k12: Option<f64>,
+}
+
+impl Default for BenchOptions {
+    fn default() -> Self {
+        Self { arastar_time_limit_s: 15.0, optimum_time_limit_s: 300.0, k12: None }
+    }
+}
+
+/// One benchmark row: an algorithm's anytime behaviour on a scenario. Costs are search
+/// costs (with the scenario's k12), which is what the search optimises.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BenchRow {
+    /// `astar` or `arastar`.
+    pub algorithm: &'static str,
+    /// `n16` or `n20`.
+    pub neighbourhood: &'static str,
+    /// The optimal cost in this neighbourhood (an A* run), if it finished.
+    pub optimum: Option<f64>,
+    /// Time of the A* run that established the optimum, s.
+    pub optimum_search_time_s: f64,
+    /// Time to the first solution, s.
+    pub first_solution_s: Option<f64>,
+    /// Its cost.
+    pub first_cost: Option<f64>,
+    /// Its cost over the optimum, % (`(first / optimum − 1) · 100`).
+    pub first_over_optimum_pct: Option<f64>,
+    /// Best cost found within 1 s.
+    pub cost_at_1s: Option<f64>,
+    /// Best cost found within 10 s.
+    pub cost_at_10s: Option<f64>,
+    /// Time until a solution of optimal cost was found, s.
+    pub time_to_optimum_s: Option<f64>,
+    /// Expansions per second of the run.
+    pub expansions_per_s: f64,
+    /// `(time_s, cost)` of every solution.
+    pub solutions: Vec<(f64, f64)>,
+}
+
+/// A benchmark of one scenario.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BenchReport {
+    /// Scenario name.
+    pub scenario: String,
+    /// Cost-map building time, s.
+    pub setup_time_s: f64,
+    /// A* then ARA*.
+    pub rows: Vec<BenchRow>,
+}
+
+/// Benchmarks A* (16-neighbourhood) and ARA* (20-neighbourhood, ε from 3) on
+/// `scenario`. The optimum of each neighbourhood comes from an A* run with
+/// `optimum_time_limit_s`; for the A* row that run is the measurement itself.
+///
+/// # Errors
+/// As [`run`]'s set-up errors, and invalid options.
+pub fn bench(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    opts: &BenchOptions,
+) -> Result<BenchReport, PlanJobError> {
+    let ara_limit = check_time("arastar_time_limit_s", opts.arastar_time_limit_s)?;
+    let opt_limit = check_time("optimum_time_limit_s", opts.optimum_time_limit_s)?;
+    let file = || scenario.path.clone();
+    let prep = prepare(scenario, robot, opts.k12, None)?;
+    let k12 = prep.params.k12;
+    let run_one = |algorithm, n, limit| -> Result<SearchResult<LatticeState>, PlanJobError> {
+        let mut g = prep
+            .graph(robot, n, k12)
+            .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
+        let p = SearchParams {
+            initial_epsilon: prep.params.arastar_initial_epsilon,
+            epsilon_decay: prep.params.arastar_epsilon_decay,
+            time_limit: Some(limit),
+            ..SearchParams::default()
+        };
+        search(&mut g, prep.start, algorithm, &p, None)
+            .map_err(|source| PlanJobError::Search { scenario: file(), source })
+    };
+    let mut rows = Vec::new();
+    let astar16 = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit)?;
+    rows.push(row("astar", "n16", &astar16, optimum_of(&astar16), &astar16));
+    let astar20 = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit)?;
+    let ara = run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit)?;
+    rows.push(row("arastar", "n20", &ara, optimum_of(&astar20), &astar20));
+    Ok(BenchReport { scenario: scenario.name.clone(), setup_time_s: prep.setup_time_s, rows })
+}
+
+fn optimum_of(r: &SearchResult<LatticeState>) -> Option<f64> {
+    (r.termination == Termination::OptimalProven)
+        .then(|| r.best().map(|s| s.cost.to_f64()))
+        .flatten()
+}
+
+fn row(
+    algorithm: &'static str,
+    neighbourhood: &'static str,
+    r: &SearchResult<LatticeState>,
+    optimum: Option<f64>,
+    reference: &SearchResult<LatticeState>,
+) -> BenchRow {
+    let sols: Vec<(f64, f64)> =
+        r.solutions.iter().map(|s| (s.time.as_secs_f64(), s.cost.to_f64())).collect();
+    let first = sols.first().copied();
+    let at = |t: f64| sols.iter().rev().find(|(ts, _)| *ts <= t).map(|&(_, c)| c);
+    // Costs are sums of the same fixed-point edges, so "optimal" is an exact match up
+    // to the micro-unit.
+    let time_to_optimum =
+        optimum.and_then(|o| sols.iter().find(|(_, c)| (c - o).abs() < 1e-6).map(|&(t, _)| t));
+    BenchRow {
+        algorithm,
+        neighbourhood,
+        optimum,
+        optimum_search_time_s: reference.elapsed.as_secs_f64(),
+        first_solution_s: first.map(|f| f.0),
+        first_cost: first.map(|f| f.1),
+        first_over_optimum_pct: first.zip(optimum).map(|(f, o)| (f.1 / o - 1.0) * 100.0),
+        cost_at_1s: at(1.0),
+        cost_at_10s: at(10.0),
+        time_to_optimum_s: time_to_optimum,
+        expansions_per_s: r.expansions as f64 / r.elapsed.as_secs_f64().max(1e-9),
+        solutions: sols,
+    }
+}

@@ -1,0 +1,929 @@
+//! The hybrid driving-stepping graph (Klamt & Behnke 2017, Sec. V): driving in the
+//! neutral footprint plus the stepping manoeuvres of Fig. 5 and Fig. 6, as one
+//! [`SearchGraph`] over [`LatticeState`]s `(i, j, θ, footprint)`.
+//!
+//! **States.** The base pose is a lattice pose (`lattice`); the footprint id names four
+//! longitudinal foot offsets in a [`FootprintTable`] (`footprint`). A foot stands at its
+//! neutral position (x', y') in the base frame moved by its offset along x'. Neutral
+//! states drive and turn exactly as in [`DrivingGraph`]; every state may in addition have
+//! these successors, each changing the footprint:
+//!
+//! - **abstract step** (Sec. V, Fig. 5, 6a): a foot moves from its pre-step to its after-step
+//!   position, forward in its sagittal plane, the base staying put. Added only when all
+//!   four criteria hold (see `HybridGraph::best_step`); its cost is C_S (eq. 5) of the
+//!   cheapest end position, the only one returned.
+//! - **longitudinal base shift** (Fig. 6b): when both front feet stand ahead of neutral,
+//!   the base moves forward over the standing feet until one front foot is neutral or a
+//!   rear leg reaches its reach limit. Cost C_BS = k10 · L_BS · C_B,avg.
+//! - **front foot forward** (Fig. 6c): when a rear foot is close to an obstacle, a front
+//!   wheel pair drives forward (keeping ground contact), preparing a rear step — as far
+//!   as its leg reaches and the terrain is drivable, in one move. Cost C_FM (eq. 6).
+//! - **foot to neutral** (Fig. 6d): in a non-neutral footprint, one wheel pair drives
+//!   back to its neutral position. Cost C_FM (eq. 6).
+//!
+//! All four manoeuvre costs are multiplied by the step-related factor
+//! ([`HybridConfig::step_cost_factor`], Sec. V, Fig. 7: the calibration is documented on
+//! `Params::step_cost_factor`).
+//!
+//! **Choices where the paper is silent** (each tested in `locomotion::tests`):
+//! - *Leg reach.* A foot offset is allowed if the sagittal leg IK (`robot::ik::leg_ik`)
+//!   reaches the foot from its hip with the hip at the manoeuvre leg height
+//!   (`Params::manoeuvre_leg_height_m`, 0.45 m) above the foot's ground, level base. This
+//!   gives each leg a fixed offset range, computed once from the model.
+//! - *Which footholds count as a step.* A step must carry the foot *over* untraversable
+//!   terrain: its straight sagittal line crosses at least one cell of infinite foot cost.
+//!   A foothold reachable over finite cells only is a wheel drive (front foot forward /
+//!   foot to neutral), not a step — otherwise the cheapest "step" would always be one
+//!   cell long.
+//! - *ΔH_step* (eq. 5) is the largest |H(c) − H(f_j)| over the cells the foot passes,
+//!   end included; the paper's third criterion bounds |H(f_j) − H(c_h)| by 0.3 m, and
+//!   Fig. 5c's "the height difference to overcome" bounds ΔH_step as well (a leg cannot
+//!   lift a foot over a 0.5 m bar even if the far side is level).
+//! - *Non-neutral states* must have all four feet on cells of finite foot cost, a finite
+//!   body cost C_B (eq. 3) with every leg at the manoeuvre leg height (the robot stands
+//!   up for manoeuvres, Sec. VI-B), and the two feet of each side at least half the
+//!   support length (`min_support_side_length_m` / 2) apart, so wheel pairs never
+//!   collide. Only neutral states drive.
+//! - *Base shifts* end on the lattice cell containing the exact shifted position (the
+//!   feet then stand up to half a cell from where they were; the paper's grid has the
+//!   same issue). The edge cost is `max(C_BS · factor, distance moved)`, which keeps the
+//!   heuristic consistent even for factors below 2.
+//!
+//! **Heuristic**: that of [`DrivingGraph`] — Euclidean distance plus the orientation
+//! difference times the turning radius. Steps and foot moves leave the base in place and
+//! cost ≥ 0; drives and base shifts cost at least the distance they move the base; so it
+//! stays consistent (and admissible).
+
+use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, edge_cost};
+use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
+use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
+use crate::cost::{Cost as CostValue, CostMaps};
+use crate::geometry::Pose2;
+use crate::params::Params;
+use crate::planner::{Cost, SearchGraph};
+use crate::robot::ik::leg_ik;
+use crate::robot::{Leg, RobotDescription};
+use serde::Serialize;
+
+/// What an edge of the hybrid graph does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ManoeuvreKind {
+    /// A straight driving move in the neutral footprint (Fig. 4 left).
+    Drive,
+    /// A turn on the spot to the next orientation (Fig. 4 right).
+    Turn,
+    /// An abstract step of one foot (Fig. 6a).
+    Step,
+    /// A longitudinal base shift (Fig. 6b).
+    BaseShift,
+    /// A front wheel pair driven forward to prepare a rear step (Fig. 6c).
+    FootForward,
+    /// A wheel pair driven back to its neutral position (Fig. 6d).
+    FootNeutral,
+}
+
+impl ManoeuvreKind {
+    /// Whether the manoeuvre is step-related (its cost carries the step-related factor).
+    pub fn is_step_related(self) -> bool {
+        !matches!(self, ManoeuvreKind::Drive | ManoeuvreKind::Turn)
+    }
+}
+
+/// The parts of a step's cost C_S (eq. 5).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StepCost {
+    /// L_step, m.
+    pub length_m: f64,
+    /// C_F(c_h), the foot cost of the foothold (eq. 1).
+    pub foothold_cost: f64,
+    /// ΔH_step, m: the largest height difference the foot overcomes.
+    pub height_m: f64,
+    /// C_S (eq. 5), before the step-related factor.
+    pub c_s: f64,
+}
+
+/// One edge of the hybrid graph, labelled.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Manoeuvre {
+    /// What it does.
+    pub kind: ManoeuvreKind,
+    /// The leg that moves (steps and foot moves).
+    pub leg: Option<Leg>,
+    /// Distance: base travel (drive, base shift), wheel travel (turn, foot moves) or the
+    /// step length, m.
+    pub length_m: f64,
+    /// The edge cost as searched, in cost units (before fixed-point rounding).
+    pub cost: f64,
+    /// The parts of C_S, for steps.
+    pub step: Option<StepCost>,
+}
+
+/// C_S = k7 · L_step + k8 · (C_F(c_h) − 1) + k9 · ΔH_step (eq. 5), before the
+/// step-related factor.
+pub fn step_cost(params: &HybridConfig, length_m: f64, foothold_cost: f64, height_m: f64) -> f64 {
+    params.k7 * length_m + params.k8 * (foothold_cost - 1.0) + params.k9 * height_m
+}
+
+/// C_BS = k10 · L_BS · C_B,avg (Sec. V), before the step-related factor.
+pub fn base_shift_cost(params: &HybridConfig, length_m: f64, body_cost_avg: f64) -> f64 {
+    params.k10 * length_m * body_cost_avg
+}
+
+/// C_FM = k11 · L_FM · C_F,avg (eq. 6), before the step-related factor.
+pub fn foot_move_cost(params: &HybridConfig, length_m: f64, foot_cost_avg: f64) -> f64 {
+    params.k11 * length_m * foot_cost_avg
+}
+
+/// Configuration of the hybrid graph: the driving part and the manoeuvre constants.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HybridConfig {
+    /// Driving moves, k_Δθ, turn radius.
+    pub driving: DrivingConfig,
+    /// Step cost weight on L_step (eq. 5).
+    pub k7: f64,
+    /// Step cost weight on C_F(c_h) − 1 (eq. 5).
+    pub k8: f64,
+    /// Step cost weight on ΔH_step (eq. 5).
+    pub k9: f64,
+    /// Base shift weight (C_BS).
+    pub k10: f64,
+    /// Single foot move weight (eq. 6).
+    pub k11: f64,
+    /// Factor on every step-related manoeuvre cost (Sec. V, Fig. 7).
+    pub step_cost_factor: f64,
+    /// Criterion 1: an infinite-cost cell closer than this to the foot, m.
+    pub step_obstacle_distance_m: f64,
+    /// Criterion 3: largest |ΔH| of a step, m.
+    pub max_step_height_m: f64,
+    /// Criterion 4: the feet on the non-stepping side must be farther apart, m.
+    pub min_support_side_length_m: f64,
+    /// Leg height for manoeuvres (reach and body clearance), m.
+    pub manoeuvre_leg_height_m: f64,
+    /// Shortest "front foot forward" move, m (each such move drives as far as it can).
+    pub foot_move_increment_m: f64,
+    /// Cap on distinct footprints (graph size guard).
+    pub max_footprints: usize,
+}
+
+impl HybridConfig {
+    /// From the paper's constants and the robot's neutral footprint; the shortest foot
+    /// move is 0.1 m and up to 65 536 footprints (all `u16` ids) are allowed.
+    pub fn new(params: &Params, robot: &RobotDescription, neighbourhood: Neighbourhood) -> Self {
+        Self {
+            driving: DrivingConfig::new(params, &robot.neutral_footprint(), neighbourhood),
+            k7: params.k7,
+            k8: params.k8,
+            k9: params.k9,
+            k10: params.k10,
+            k11: params.k11,
+            step_cost_factor: params.step_cost_factor,
+            step_obstacle_distance_m: params.step_obstacle_distance_m,
+            max_step_height_m: params.max_step_height_m,
+            min_support_side_length_m: params.min_support_side_length_m,
+            manoeuvre_leg_height_m: params.manoeuvre_leg_height_m,
+            foot_move_increment_m: 0.1,
+            max_footprints: 65_536,
+        }
+    }
+}
+
+/// Where the four feet of a state stand and what is under them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Feet {
+    /// World (x, y), FL, FR, RL, RR.
+    pos: [[f64; 2]; 4],
+    /// Foot cost C_F of each foot's cell (finite).
+    cf: [f64; 4],
+    /// Ground height of each foot's cell, m.
+    h: [f64; 4],
+}
+
+/// Counters of the manoeuvres generated, for reports and tests.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct ManoeuvreStats {
+    /// Steps generated (edges, counted per expansion).
+    pub steps: u64,
+    /// Base shifts generated.
+    pub base_shifts: u64,
+    /// Front-foot-forward moves generated.
+    pub foot_forward: u64,
+    /// Foot-to-neutral moves generated.
+    pub foot_neutral: u64,
+    /// Manoeuvres dropped because the footprint table was full.
+    pub footprint_table_full: u64,
+}
+
+/// The hybrid graph over one cost map.
+pub struct HybridGraph<'c> {
+    maps: &'c CostMaps,
+    driving: DrivingGraph<'c, CostMaps>,
+    config: HybridConfig,
+    lattice: Lattice,
+    /// Neutral foot positions in the base frame (x', y'), FL, FR, RL, RR.
+    neutral: [[f64; 2]; 4],
+    /// Widest offset range per leg, cells: `[min, max]`, over every leg height a
+    /// manoeuvre can give it (the scan bound; the exact check is [`Self::in_reach`]).
+    reach: [[i8; 2]; 4],
+    /// Per centimetre of leg height below the manoeuvre height (index 0 = the
+    /// manoeuvre height), per leg, the offsets the leg IK reaches as a bit set (bit
+    /// `o + 64` for offset `o`): the IK solved once here instead of four times per state
+    /// on the search's hot path. A set, not a range: with short legs the foot right under
+    /// the hip needs the knee folded past its limit, while one further forward does not.
+    reach_by_height: Vec<[u128; 4]>,
+    footprints: FootprintTable,
+    /// Per map cell: an infinite-foot-cost cell lies within the criterion-1 radius plus
+    /// half a cell diagonal of its centre (a conservative pre-filter for criterion 1).
+    near: Vec<bool>,
+    /// `(sin θ, cos θ)` per orientation index.
+    trig: Vec<(f64, f64)>,
+    /// Shortest "front foot forward" move, cells.
+    foot_move_cells: i8,
+    /// Scratch buffer for the labelled special successors.
+    special: Vec<(LatticeState, Cost, Manoeuvre)>,
+    stats: ManoeuvreStats,
+}
+
+/// The offsets (cells, −64..=63) at which `leg` reaches its foot with the hip `height`
+/// above the ground (sagittal leg IK, level base), as a bit set: bit `o + 64`.
+fn leg_reach(robot: &RobotDescription, leg: Leg, height: f64, res: f64) -> u128 {
+    let mut bits = 0u128;
+    for o in -64..64_i32 {
+        let x = robot.neutral_foot_offset_x[leg.index()] + f64::from(o) * res;
+        if leg_ik(robot, leg, [x, -height], 0.0).is_ok() {
+            bits |= 1 << (o + 64);
+        }
+    }
+    bits
+}
+
+/// The smallest and largest offset in a reach bit set (`[0, 0]` if empty).
+fn bit_range(bits: u128) -> [i8; 2] {
+    if bits == 0 {
+        return [0, 0];
+    }
+    let lo = bits.trailing_zeros() as i32 - 64;
+    let hi = 127 - bits.leading_zeros() as i32 - 64;
+    [lo as i8, hi as i8]
+}
+
+impl<'c> HybridGraph<'c> {
+    /// The hybrid graph on `maps` (lattice over its height map with `orientations`
+    /// orientations) searching for `goal`.
+    ///
+    /// # Errors
+    /// A map too large for the lattice or an invalid orientation count.
+    pub fn new(
+        maps: &'c CostMaps,
+        robot: &RobotDescription,
+        orientations: u32,
+        config: HybridConfig,
+        goal: DrivingGoal,
+    ) -> Result<Self, LatticeError> {
+        let lattice = Lattice::for_map(maps.heights(), orientations)?;
+        let res = lattice.resolution;
+        // Leg heights a manoeuvre gives range from the manoeuvre height down to that less
+        // the largest step; take the union of the reach over them, in 1 cm steps.
+        let mut union = [0u128; 4];
+        let mut reach_by_height = Vec::new();
+        for cm in 0..=(config.max_step_height_m * 100.0).ceil() as i32 + 1 {
+            let h = config.manoeuvre_leg_height_m - f64::from(cm) * 0.01;
+            let row = Leg::ALL.map(|leg| leg_reach(robot, leg, h, res));
+            for k in 0..4 {
+                union[k] |= row[k];
+            }
+            reach_by_height.push(row);
+        }
+        let reach = union.map(bit_range);
+        let trig = (0..lattice.orientations).map(|k| lattice.yaw(k as u8).sin_cos()).collect();
+        let foot_move_cells = (config.foot_move_increment_m / res).round().clamp(1.0, 127.0) as i8;
+        Ok(Self {
+            maps,
+            driving: DrivingGraph::new(maps, lattice, config.driving, goal),
+            near: near_obstacle_layer(maps, config.step_obstacle_distance_m),
+            config,
+            lattice,
+            neutral: maps.neutral_footprint(),
+            reach,
+            reach_by_height,
+            footprints: FootprintTable::new(config.max_footprints),
+            trig,
+            foot_move_cells,
+            special: Vec::with_capacity(16),
+            stats: ManoeuvreStats::default(),
+        })
+    }
+
+    /// The lattice.
+    pub fn lattice(&self) -> &Lattice {
+        &self.lattice
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &HybridConfig {
+        &self.config
+    }
+
+    /// The widest offset range `[min, max]` (cells) of each leg.
+    pub fn reach(&self) -> [[i8; 2]; 4] {
+        self.reach
+    }
+
+    /// Manoeuvres generated so far.
+    pub fn stats(&self) -> ManoeuvreStats {
+        self.stats
+    }
+
+    /// Number of footprints met so far (the neutral one included).
+    pub fn footprint_count(&self) -> usize {
+        self.footprints.len()
+    }
+
+    /// The foot offsets (cells) of a state's footprint.
+    pub fn offsets(&self, s: LatticeState) -> Option<FootOffsets> {
+        self.footprints.get(s.footprint)
+    }
+
+    /// The state at `s`'s pose with footprint `offsets` (interned in this graph's table;
+    /// footprint ids are per graph, so a state moves between graphs by its offsets).
+    /// `None` when the footprint table is full.
+    pub fn with_offsets(&mut self, s: LatticeState, offsets: FootOffsets) -> Option<LatticeState> {
+        self.with_footprint(s, offsets)
+    }
+
+    /// The base pose of a state.
+    pub fn pose(&self, s: LatticeState) -> Pose2 {
+        self.lattice.pose(s)
+    }
+
+    /// World (x, y) of the four feet of a state (FL, FR, RL, RR).
+    pub fn feet(&self, s: LatticeState) -> Option<[[f64; 2]; 4]> {
+        let o = self.footprints.get(s.footprint)?;
+        Some(self.feet_pos(s, &o))
+    }
+
+    /// Known ground height under (x, y), m.
+    pub fn height_at(&self, x: f64, y: f64) -> Option<f64> {
+        self.maps.height_at(x, y)
+    }
+
+    /// Pose cost of a neutral state (the driving cost, ≥ 1), `None` if untraversable.
+    pub fn driving_pose_cost(&mut self, s: LatticeState) -> Option<f64> {
+        self.driving.pose_cost(LatticeState { footprint: NEUTRAL_FOOTPRINT, ..s })
+    }
+
+    #[inline]
+    fn heading(&self, theta: u8) -> (f64, f64) {
+        let (s, c) = self.trig[usize::from(theta)];
+        (c, s)
+    }
+
+    #[inline]
+    fn feet_pos(&self, s: LatticeState, o: &FootOffsets) -> [[f64; 2]; 4] {
+        let p = self.lattice.pose(s);
+        let (sn, cs) = self.trig[usize::from(s.theta)];
+        let res = self.lattice.resolution;
+        std::array::from_fn(|k| {
+            let fx = self.neutral[k][0] + f64::from(o[k]) * res;
+            let fy = self.neutral[k][1];
+            [p.x + cs * fx - sn * fy, p.y + sn * fx + cs * fy]
+        })
+    }
+
+    /// Foot cost and ground height of the cell under (x, y): `Err(true)` for an
+    /// infinite foot cost, `Err(false)` for unknown terrain or off the map.
+    #[inline]
+    fn cell(&self, x: f64, y: f64) -> Result<(f64, f64), bool> {
+        let hm = self.maps.heights();
+        let Some((i, j)) = hm.cell_of(x, y) else {
+            return Err(false);
+        };
+        let h = hm.get(i, j).ok_or(false)?;
+        match self.maps.foot_cost_cell(i, j) {
+            CostValue::Finite(c) => Ok((c, h)),
+            CostValue::Infinite => Err(true),
+            CostValue::Unknown => Err(false),
+        }
+    }
+
+    /// Feet of a state with offsets `o`, all on known cells of finite foot cost.
+    fn feet_of(&self, s: LatticeState, o: &FootOffsets) -> Option<Feet> {
+        let pos = self.feet_pos(s, o);
+        let mut cf = [0.0; 4];
+        let mut h = [0.0; 4];
+        for k in 0..4 {
+            let (c, hh) = self.cell(pos[k][0], pos[k][1]).ok()?;
+            cf[k] = c;
+            h[k] = hh;
+        }
+        Some(Feet { pos, cf, h })
+    }
+
+    /// Criterion 1 (Sec. V): an infinite-foot-cost cell lies closer than
+    /// `step_obstacle_distance_m` to the foot at (x, y).
+    #[inline]
+    fn near_obstacle(&self, p: [f64; 2]) -> bool {
+        let hm = self.maps.heights();
+        let Some((i, j)) = hm.cell_of(p[0], p[1]) else {
+            return false;
+        };
+        self.near[j * hm.nx() + i]
+            && self.maps.infinite_foot_cost_within(p[0], p[1], self.config.step_obstacle_distance_m)
+    }
+
+    /// Longitudinal distance between the two feet on one side (left: FL–RL), m.
+    fn side_length(&self, o: &FootOffsets, left: bool) -> f64 {
+        let (f, r) = if left { (0, 2) } else { (1, 3) };
+        let res = self.lattice.resolution;
+        (self.neutral[f][0] + f64::from(o[f]) * res) - (self.neutral[r][0] + f64::from(o[r]) * res)
+    }
+
+    /// Leg heights (hip above the foot's ground, m) during a manoeuvre: the base level
+    /// at the manoeuvre leg height above the lowest foot (see the module docs).
+    fn leg_heights(&self, ground: &[f64; 4]) -> [f64; 4] {
+        let low = ground.iter().copied().fold(f64::INFINITY, f64::min);
+        ground.map(|g| self.config.manoeuvre_leg_height_m - (g - low))
+    }
+
+    /// Whether leg `k`'s foot at offset `o` (cells) is reachable with the hip `height`
+    /// above its ground (sagittal leg IK, level base): reachable at both neighbouring
+    /// centimetres of the precomputed table, so rounding never admits a pose the IK
+    /// rejects at the table's heights.
+    fn in_reach(&self, k: usize, o: i8, height: f64) -> bool {
+        let below = (self.config.manoeuvre_leg_height_m - height) * 100.0;
+        if !below.is_finite() || below < -1e-9 {
+            return false;
+        }
+        let lo = below.floor().max(0.0) as usize;
+        let hi = below.ceil().max(0.0) as usize;
+        let Ok(bit) = u32::try_from(i32::from(o) + 64) else {
+            return false;
+        };
+        if bit >= 128 {
+            return false;
+        }
+        [lo, hi]
+            .iter()
+            .all(|&r| self.reach_by_height.get(r).is_some_and(|row| row[k] & (1 << bit) != 0))
+    }
+
+    /// Whether a non-neutral footprint is within reach (feet on `ground`) and keeps the
+    /// wheel pairs apart.
+    fn footprint_ok(&self, o: &FootOffsets, ground: &[f64; 4]) -> bool {
+        let min_side = 0.5 * self.config.min_support_side_length_m;
+        if self.side_length(o, true) < min_side || self.side_length(o, false) < min_side {
+            return false;
+        }
+        let legs = self.leg_heights(ground);
+        (0..4).all(|k| {
+            (self.reach[k][0]..=self.reach[k][1]).contains(&o[k]) && self.in_reach(k, o[k], legs[k])
+        })
+    }
+
+    /// Whether state `t` (footprint offsets `o`) may be entered; its body cost for
+    /// non-neutral footprints.
+    fn target_ok(&mut self, t: LatticeState, o: &FootOffsets) -> bool {
+        if *o == NEUTRAL_OFFSETS {
+            return self.driving.pose_cost(t).is_some();
+        }
+        let Some(feet) = self.feet_of(t, o) else {
+            return false;
+        };
+        if !self.footprint_ok(o, &feet.h) {
+            return false;
+        }
+        let legs = self.leg_heights(&feet.h);
+        self.maps.body_cost(&self.lattice.pose(t), &feet.pos, &legs).is_finite()
+    }
+
+    /// Interns `o` and returns the state at `(i, j, θ)` with that footprint.
+    fn with_footprint(&mut self, t: LatticeState, o: FootOffsets) -> Option<LatticeState> {
+        match self.footprints.intern(o) {
+            Some(footprint) => Some(LatticeState { footprint, ..t }),
+            None => {
+                self.stats.footprint_table_full += 1;
+                None
+            }
+        }
+    }
+
+    /// The cheapest abstract step of `leg` from state `s` (offsets `o`, feet `feet`),
+    /// given that criteria 1 (close to an obstacle) and 4 (support side) hold: scans the
+    /// foot's sagittal line forward to the end of the leg's reach for footholds that
+    ///
+    /// - have finite foot cost C_F (criterion 2) and lie beyond at least one cell of
+    ///   infinite C_F (the foot is carried over the obstacle, see the module docs),
+    /// - differ in height from the foot by at most `max_step_height_m` (criterion 3),
+    ///   as does every cell passed on the way,
+    /// - give a valid after-step state,
+    ///
+    /// and returns the one with the smallest C_S (eq. 5; ties: the shorter step) with its
+    /// new offsets.
+    fn best_step(
+        &mut self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        leg: usize,
+    ) -> Option<(FootOffsets, StepCost)> {
+        let res = self.lattice.resolution;
+        let (hx, hy) = self.heading(s.theta);
+        let [x0, y0] = feet.pos[leg];
+        let h0 = feet.h[leg];
+        let max_d = i32::from(self.reach[leg][1]) - i32::from(o[leg]);
+        let mut crossed = false;
+        let mut dh_max = 0.0_f64;
+        let mut best: Option<(FootOffsets, StepCost)> = None;
+        for d in 1..=max_d {
+            let l = f64::from(d) * res;
+            let (x, y) = (x0 + hx * l, y0 + hy * l);
+            let hm = self.maps.heights();
+            let Some((i, j)) = hm.cell_of(x, y) else {
+                break;
+            };
+            // Unknown terrain cannot be stepped over: the leg could hit anything.
+            let Some(h) = hm.get(i, j) else { break };
+            dh_max = dh_max.max((h - h0).abs());
+            if dh_max > self.config.max_step_height_m {
+                break;
+            }
+            let cf = match self.maps.foot_cost_cell(i, j) {
+                CostValue::Finite(c) => c,
+                CostValue::Infinite => {
+                    crossed = true;
+                    continue;
+                }
+                CostValue::Unknown => break,
+            };
+            if !crossed {
+                continue;
+            }
+            let c_s = step_cost(&self.config, l, cf, dh_max);
+            if best.as_ref().is_some_and(|(_, b)| b.c_s <= c_s) {
+                continue;
+            }
+            let mut o2 = *o;
+            o2[leg] = (i32::from(o[leg]) + d) as i8;
+            if !self.target_ok(s, &o2) {
+                continue;
+            }
+            best = Some((o2, StepCost { length_m: l, foothold_cost: cf, height_m: dh_max, c_s }));
+        }
+        best
+    }
+
+    /// Mean foot cost along a wheel pair's straight drive of `cells` cells from `p` in
+    /// direction `dir` (both ends included); `None` if any cell is not drivable.
+    fn drive_line_cost(&self, p: [f64; 2], dir: (f64, f64), cells: i32) -> Option<f64> {
+        let res = self.lattice.resolution;
+        let mut sum = 0.0;
+        for k in 0..=cells {
+            let l = f64::from(k) * res;
+            let (c, _) = self.cell(p[0] + dir.0 * l, p[1] + dir.1 * l).ok()?;
+            sum += c;
+        }
+        Some(sum / f64::from(cells + 1))
+    }
+
+    /// Appends the labelled non-driving successors of `s` (steps, base shifts, foot
+    /// moves) to `self.special`.
+    fn special_successors(&mut self, s: LatticeState) {
+        self.special.clear();
+        let Some(o) = self.footprints.get(s.footprint) else {
+            return;
+        };
+        let neutral = o == NEUTRAL_OFFSETS;
+        let pos = self.feet_pos(s, &o);
+        let near = pos.map(|p| self.near_obstacle(p));
+        // Neutral states only have steps and front-foot-forward moves, both of which need
+        // a foot close to an obstacle: the common case ends here.
+        if neutral && !near.iter().any(|&n| n) {
+            return;
+        }
+        let Some(feet) = self.feet_of(s, &o) else {
+            return;
+        };
+        let f = self.config.step_cost_factor;
+        let res = self.lattice.resolution;
+        let heading = self.heading(s.theta);
+
+        // Abstract steps: criteria 1 and 4 here, 2 and 3 in `best_step`.
+        for leg in Leg::ALL {
+            let k = leg.index();
+            if !near[k] {
+                continue;
+            }
+            // Criterion 4: the two feet on the other side carry the robot while it steps.
+            if self.side_length(&o, !leg.is_left()) <= self.config.min_support_side_length_m {
+                continue;
+            }
+            let Some((o2, step)) = self.best_step(s, &o, &feet, k) else {
+                continue;
+            };
+            let Some(t) = self.with_footprint(s, o2) else {
+                continue;
+            };
+            let cost = f * step.c_s;
+            self.stats.steps += 1;
+            self.special.push((
+                t,
+                edge_cost(cost),
+                Manoeuvre {
+                    kind: ManoeuvreKind::Step,
+                    leg: Some(leg),
+                    length_m: step.length_m,
+                    cost,
+                    step: Some(step),
+                },
+            ));
+        }
+
+        // Longitudinal base shift: both front feet ahead of neutral; forward until a
+        // front foot is neutral or a rear leg is at the end of its reach.
+        if o[0] > 0 && o[1] > 0 {
+            let legs = self.leg_heights(&feet.h);
+            let mut l = o[0].min(o[1]);
+            while l > 0 && ![2, 3].iter().all(|&r| self.in_reach(r, o[r] - l, legs[r])) {
+                l -= 1;
+            }
+            if l > 0 {
+                self.push_base_shift(s, &o, &feet, l);
+            }
+        }
+
+        // Front wheel pairs forward, preparing a rear step: when a rear foot is close to
+        // an obstacle (Sec. V). One move per foot, as far as the leg reaches and the
+        // wheels can drive (at least `foot_move_increment_m`): shorter moves would only
+        // multiply footprints, and a later base shift uses the whole lead.
+        if near[2] || near[3] {
+            for leg in [Leg::FrontLeft, Leg::FrontRight] {
+                self.push_foot_forward(s, &o, &feet, leg);
+            }
+        }
+
+        // A wheel pair back to neutral. Moves of different feet commute, so only the
+        // first foot (in FL, FR, RL, RR order) that can move is offered: the same
+        // footprints stay reachable, through a chain instead of every subset of feet
+        // (2^4 intermediate footprints per pose become 4).
+        if !neutral {
+            for leg in Leg::ALL {
+                let k = leg.index();
+                if o[k] == 0 {
+                    continue;
+                }
+                let back = if o[k] > 0 { (-heading.0, -heading.1) } else { heading };
+                let cells = i32::from(o[k]).abs();
+                let Some(avg) = self.drive_line_cost(feet.pos[k], back, cells) else {
+                    continue;
+                };
+                let mut o2 = o;
+                o2[k] = 0;
+                let length = f64::from(cells) * res;
+                if self.push_foot_move(s, o2, leg, ManoeuvreKind::FootNeutral, length, avg) {
+                    break;
+                }
+            }
+        }
+    }
+
+    fn push_foot_move(
+        &mut self,
+        s: LatticeState,
+        o2: FootOffsets,
+        leg: Leg,
+        kind: ManoeuvreKind,
+        length: f64,
+        avg: f64,
+    ) -> bool {
+        if !self.target_ok(s, &o2) {
+            return false;
+        }
+        let Some(t) = self.with_footprint(s, o2) else {
+            return false;
+        };
+        let cost = self.config.step_cost_factor * foot_move_cost(&self.config, length, avg);
+        match kind {
+            ManoeuvreKind::FootForward => self.stats.foot_forward += 1,
+            _ => self.stats.foot_neutral += 1,
+        }
+        self.special.push((
+            t,
+            edge_cost(cost),
+            Manoeuvre { kind, leg: Some(leg), length_m: length, cost, step: None },
+        ));
+        true
+    }
+
+    /// The "front foot forward" move of `leg` (see `special_successors`).
+    fn push_foot_forward(&mut self, s: LatticeState, o: &FootOffsets, feet: &Feet, leg: Leg) {
+        let k = leg.index();
+        let res = self.lattice.resolution;
+        let (hx, hy) = self.heading(s.theta);
+        let [x0, y0] = feet.pos[k];
+        let max_d = i32::from(self.reach[k][1]) - i32::from(o[k]);
+        // Prefix sums of C_F along the drivable part of the line.
+        let mut sums = [0.0_f64; 128];
+        sums[0] = feet.cf[k];
+        let mut last = 0;
+        for d in 1..=max_d.min(127) {
+            let l = f64::from(d) * res;
+            match self.cell(x0 + hx * l, y0 + hy * l) {
+                Ok((c, _)) => {
+                    sums[d as usize] = sums[d as usize - 1] + c;
+                    last = d;
+                }
+                Err(_) => break,
+            }
+        }
+        let min_d = i32::from(self.foot_move_cells);
+        let mut d = last;
+        while d >= min_d {
+            let mut o2 = *o;
+            o2[k] = (i32::from(o[k]) + d) as i8;
+            let avg = sums[d as usize] / f64::from(d + 1);
+            let length = f64::from(d) * res;
+            if self.push_foot_move(s, o2, leg, ManoeuvreKind::FootForward, length, avg) {
+                return;
+            }
+            d -= 1;
+        }
+    }
+
+    /// A base shift by `l` cells over the standing feet (see the module docs).
+    fn push_base_shift(&mut self, s: LatticeState, o: &FootOffsets, feet: &Feet, l: i8) {
+        let res = self.lattice.resolution;
+        let (hx, hy) = self.heading(s.theta);
+        let p = self.lattice.pose(s);
+        let legs = self.leg_heights(&feet.h);
+        // C_B,avg: the body cost at every cell-length of the shift, feet fixed in the world.
+        let mut sum = 0.0;
+        for k in 0..=l {
+            let d = f64::from(k) * res;
+            let pk = Pose2::new(p.x + hx * d, p.y + hy * d, p.theta);
+            match self.maps.body_cost(&pk, &feet.pos, &legs).finite() {
+                Some(c) => sum += c,
+                None => return,
+            }
+        }
+        let cb_avg = sum / f64::from(l + 1);
+        let length = f64::from(l) * res;
+        let end = Pose2::new(p.x + hx * length, p.y + hy * length, p.theta);
+        let Some(cell) = self.lattice.state(&end) else {
+            return;
+        };
+        let moved = self.lattice.pose(cell).distance(&p);
+        let o2 = o.map(|v| v - l);
+        let t = LatticeState { i: cell.i, j: cell.j, ..s };
+        if !self.target_ok(t, &o2) {
+            return;
+        }
+        let Some(t) = self.with_footprint(t, o2) else {
+            return;
+        };
+        let cost = (self.config.step_cost_factor * base_shift_cost(&self.config, length, cb_avg))
+            .max(moved);
+        self.stats.base_shifts += 1;
+        self.special.push((
+            t,
+            edge_cost(cost),
+            Manoeuvre {
+                kind: ManoeuvreKind::BaseShift,
+                leg: None,
+                length_m: moved,
+                cost,
+                step: None,
+            },
+        ));
+    }
+
+    /// Every successor of `s` with its cost and label, in the search's order.
+    pub fn labelled_successors(&mut self, s: LatticeState) -> Vec<(LatticeState, Cost, Manoeuvre)> {
+        let mut out = Vec::new();
+        if s.footprint == NEUTRAL_FOOTPRINT {
+            let mut plain = Vec::new();
+            self.driving.successors(s, &mut plain);
+            let a = self.lattice.pose(s);
+            for (t, c) in plain {
+                let b = self.lattice.pose(t);
+                let m = if (t.i, t.j) == (s.i, s.j) {
+                    Manoeuvre {
+                        kind: ManoeuvreKind::Turn,
+                        leg: None,
+                        length_m: self.driving.config().turn_radius_m
+                            * self.lattice.orientation_step(),
+                        cost: c.to_f64(),
+                        step: None,
+                    }
+                } else {
+                    Manoeuvre {
+                        kind: ManoeuvreKind::Drive,
+                        leg: None,
+                        length_m: a.distance(&b),
+                        cost: c.to_f64(),
+                        step: None,
+                    }
+                };
+                out.push((t, c, m));
+            }
+        }
+        self.special_successors(s);
+        out.extend_from_slice(&self.special);
+        out
+    }
+
+    /// The cheapest edge from `s` to `t`, labelled; `None` if there is none.
+    pub fn edge(&mut self, s: LatticeState, t: LatticeState) -> Option<(Cost, Manoeuvre)> {
+        self.labelled_successors(s)
+            .into_iter()
+            .filter(|(u, _, _)| *u == t)
+            .map(|(_, c, m)| (c, m))
+            .min_by_key(|(c, _)| *c)
+    }
+}
+
+/// The criterion-1 pre-filter: per cell, whether an infinite-foot-cost cell's centre lies
+/// within `radius` plus half a cell diagonal of the cell's centre (so for every point of
+/// the cell, "an infinite cell closer than `radius`" implies the flag). Stamps a disc
+/// around each infinite cell on the border of an infinite region only: the nearest
+/// infinite cell to any other cell is such a border cell.
+fn near_obstacle_layer(maps: &CostMaps, radius: f64) -> Vec<bool> {
+    let hm = maps.heights();
+    let (nx, ny) = hm.dims();
+    let res = hm.resolution();
+    let inf = |i: isize, j: isize| {
+        i >= 0
+            && j >= 0
+            && (i as usize) < nx
+            && (j as usize) < ny
+            && maps.foot_cost_cell(i as usize, j as usize) == CostValue::Infinite
+    };
+    let r = radius.max(0.0) + res * std::f64::consts::FRAC_1_SQRT_2;
+    let reach = (r / res).ceil() as isize;
+    let mut disc = Vec::new();
+    for dy in -reach..=reach {
+        for dx in -reach..=reach {
+            if res * ((dx * dx + dy * dy) as f64).sqrt() < r {
+                disc.push((dx, dy));
+            }
+        }
+    }
+    let mut near = vec![false; nx * ny];
+    for j in 0..ny as isize {
+        for i in 0..nx as isize {
+            if !inf(i, j) {
+                continue;
+            }
+            let border = (-1..=1).any(|dy| (-1..=1).any(|dx| !inf(i + dx, j + dy)));
+            if !border {
+                near[j as usize * nx + i as usize] = true;
+                continue;
+            }
+            for &(dx, dy) in &disc {
+                let (a, b) = (i + dx, j + dy);
+                if a >= 0 && b >= 0 && (a as usize) < nx && (b as usize) < ny {
+                    near[b as usize * nx + a as usize] = true;
+                }
+            }
+        }
+    }
+    near
+}
+
+impl SearchGraph for HybridGraph<'_> {
+    type State = LatticeState;
+
+    fn successors(&mut self, s: LatticeState, out: &mut Vec<(LatticeState, Cost)>) {
+        if s.footprint == NEUTRAL_FOOTPRINT {
+            self.driving.successors(s, out);
+        }
+        self.special_successors(s);
+        out.extend(self.special.iter().map(|&(t, c, _)| (t, c)));
+    }
+
+    fn heuristic(&self, s: LatticeState) -> Cost {
+        self.driving.heuristic(s)
+    }
+
+    fn is_goal(&self, s: LatticeState) -> bool {
+        self.driving.is_goal(s)
+    }
+
+    fn dense_len(&self) -> usize {
+        usize::from(self.lattice.nx)
+            * usize::from(self.lattice.ny)
+            * usize::from(self.lattice.orientations)
+    }
+
+    /// Neutral states only: `(j·nx + i)·orientations + θ`, the layout of the driving
+    /// pose-cost cache, so a cell's orientations share cache lines.
+    #[inline]
+    fn dense_index(&self, s: LatticeState) -> Option<usize> {
+        if s.footprint != NEUTRAL_FOOTPRINT
+            || !self.lattice.contains(i32::from(s.i), i32::from(s.j))
+        {
+            return None;
+        }
+        let cell = s.j as usize * usize::from(self.lattice.nx) + s.i as usize;
+        Some(cell * usize::from(self.lattice.orientations) + usize::from(s.theta))
+    }
+}

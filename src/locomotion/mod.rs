@@ -1,0 +1,33 @@
+//! The hybrid driving-stepping graph (Klamt & Behnke 2017, Sec. V and VII): the paper's
+//! "neighbour client". It turns cost queries (`cost::CostMaps`) into a
+//! [`crate::planner::SearchGraph`] that the generic A* / ARA* of `planner` search.
+//!
+//! - [`lattice`]: discrete poses `(i, j, θ index, footprint)` on the height map's grid,
+//!   and the 16- / 20-neighbourhood driving moves.
+//! - [`orientation`]: the orientation cost factor k_Δθ (Fig. 8).
+//! - [`driving`]: the driving graph (moves and turns on the spot, their costs, the
+//!   heuristic) and `plan_driving`.
+//! - [`footprint`]: footprints (per-leg longitudinal foot offsets) interned as small ids.
+//! - [`hybrid`]: the full hybrid graph — driving plus abstract steps, base shifts and
+//!   single-foot moves (Sec. V), with their costs C_S (eq. 5), C_BS and C_FM (eq. 6).
+
+pub mod driving;
+pub mod footprint;
+pub mod hybrid;
+pub mod lattice;
+pub mod orientation;
+
+#[cfg(test)]
+mod tests;
+
+pub use driving::{
+    Algorithm, DrivingConfig, DrivingGoal, DrivingGraph, DrivingPlanError, PoseCostSource,
+    plan_driving,
+};
+pub use footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
+pub use hybrid::{
+    HybridConfig, HybridGraph, Manoeuvre, ManoeuvreKind, ManoeuvreStats, StepCost, base_shift_cost,
+    foot_move_cost, step_cost,
+};
+pub use lattice::{Lattice, LatticeError, LatticeState, Move, NEUTRAL_FOOTPRINT, Neighbourhood};
+pub use orientation::OrientationFactor;

@@ -1,0 +1,529 @@
+//! Tests of the driving graph: straight drives, obstacles, orientation preference, the
+//! 20-neighbourhood's effect on ARA*, heuristic consistency, and the `CostMaps` adapter.
+
+use super::*;
+use crate::geometry::Pose2;
+use crate::params::Params;
+use crate::planner::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
+use proptest::prelude::*;
+use std::f64::consts::FRAC_PI_2;
+
+fn lattice(n: u16, orientations: u16) -> Lattice {
+    Lattice { origin: [0.0, 0.0], resolution: 0.025, nx: n, ny: n, orientations }
+}
+
+/// A neutral footprint of ±0.4 m × ±0.3 m: turn radius 0.5 m.
+fn config(neighbourhood: Neighbourhood) -> DrivingConfig {
+    let fp = [[0.4, 0.3], [0.4, -0.3], [-0.4, 0.3], [-0.4, -0.3]];
+    DrivingConfig::new(&Params::default(), &fp, neighbourhood)
+}
+
+fn flat(_: &Pose2) -> Option<f64> {
+    Some(1.0)
+}
+
+fn goal(i: i16, j: i16, theta: u8) -> DrivingGoal {
+    DrivingGoal { i, j, theta: Some(theta) }
+}
+
+#[test]
+fn config_turn_radius_from_footprint() {
+    assert!((config(Neighbourhood::N16).turn_radius_m - 0.5).abs() < 1e-12);
+}
+
+#[test]
+fn straight_drive_on_flat_ground_is_exact() {
+    let mut g =
+        DrivingGraph::new(&flat, lattice(60, 64), config(Neighbourhood::N16), goal(30, 10, 0));
+    let r = astar(&mut g, LatticeState::new(10, 10, 0), &SearchParams::default());
+    let best = r.best().expect("a path on flat ground");
+    assert_eq!(best.cost, Cost::from_f64(0.5)); // 20 cells of 2.5 cm, C = 1, k = 1
+    assert!(best.path.iter().all(|s| s.j == 10 && s.theta == 0));
+    assert_eq!(best.path.len(), 21);
+}
+
+#[test]
+fn turning_on_the_spot_costs_wheel_travel() {
+    let mut g =
+        DrivingGraph::new(&flat, lattice(20, 64), config(Neighbourhood::N16), goal(5, 5, 16));
+    let r = astar(&mut g, LatticeState::new(5, 5, 0), &SearchParams::default());
+    let best = r.best().expect("path");
+    // 16 steps of 2π/64 at 0.5 m: π/4 m of wheel travel.
+    let expected = 16.0 * Cost::from_f64_ceil(0.5 * std::f64::consts::TAU / 64.0).to_f64();
+    assert!((best.cost.to_f64() - expected).abs() < 1e-9, "{}", best.cost);
+    assert!(best.path.iter().all(|s| (s.i, s.j) == (5, 5)));
+}
+
+#[test]
+fn long_sideways_goal_turns_instead_of_crabbing() {
+    // 3 m to the left, heading +x at start and goal: crabbing costs 3 · k12 = 6, turning
+    // twice by 90° costs 2 · π/4 and driving forward 3.
+    let l = lattice(150, 64);
+    let mut g = DrivingGraph::new(&flat, l, config(Neighbourhood::N16), goal(10, 130, 0));
+    let r = astar(&mut g, LatticeState::new(10, 10, 0), &SearchParams::default());
+    let best = r.best().expect("path");
+    assert!(best.cost.to_f64() < 3.0 + FRAC_PI_2 + 0.01, "{}", best.cost);
+    let l = g.lattice();
+    let max_turn = best.path.iter().map(|s| l.orientation_steps_between(s.theta, 0)).max();
+    assert!(max_turn >= Some(8), "turned at most {max_turn:?} steps: crabbed");
+}
+
+#[test]
+fn backwards_beats_sideways_for_a_short_reverse() {
+    // 0.5 m straight behind: reversing costs 0.5 · 1.5 = 0.75; turning around costs π/2
+    // and crabbing is worse. The path must keep orientation 0 and drive -x.
+    let mut g =
+        DrivingGraph::new(&flat, lattice(60, 64), config(Neighbourhood::N16), goal(10, 30, 0));
+    let r = astar(&mut g, LatticeState::new(30, 30, 0), &SearchParams::default());
+    let best = r.best().expect("path");
+    assert!(best.path.iter().all(|s| s.theta == 0 && s.j == 30));
+    assert_eq!(best.cost, Cost::from_f64(0.75));
+}
+
+/// A wall at i ∈ [29, 31] with a gap at j ∈ [40, 45), untraversable; elsewhere cost 1.
+/// (Three cells thick: two-cell moves hop one-cell walls; see `driving`.)
+fn walled(p: &Pose2) -> Option<f64> {
+    let i = (p.x / 0.025).floor() as i32;
+    let j = (p.y / 0.025).floor() as i32;
+    if (29..=31).contains(&i) && !(40..45).contains(&j) { None } else { Some(1.0) }
+}
+
+#[test]
+fn obstacles_are_avoided() {
+    let mut g =
+        DrivingGraph::new(&walled, lattice(60, 16), config(Neighbourhood::N16), goal(50, 10, 0));
+    let r = astar(&mut g, LatticeState::new(10, 10, 0), &SearchParams::default());
+    let best = r.best().expect("a path through the gap");
+    let mut g2 =
+        DrivingGraph::new(&walled, lattice(60, 16), config(Neighbourhood::N16), goal(50, 10, 0));
+    for s in &best.path {
+        assert!(g2.pose_cost(*s).is_some(), "{s:?} is untraversable");
+    }
+    assert!(best.path.iter().any(|s| s.i == 30 && (40..45).contains(&s.j)));
+    // Closing the gap leaves no path.
+    let closed = |p: &Pose2| {
+        let i = (p.x / 0.025).floor() as i32;
+        if (29..=31).contains(&i) { None } else { Some(1.0) }
+    };
+    let mut g =
+        DrivingGraph::new(&closed, lattice(60, 16), config(Neighbourhood::N16), goal(50, 10, 0));
+    let r = astar(&mut g, LatticeState::new(10, 10, 0), &SearchParams::default());
+    assert_eq!(r.termination, Termination::NoPath);
+}
+
+fn knight_moves(path: &[LatticeState]) -> usize {
+    path.windows(2)
+        .filter(|w| {
+            let (di, dj) = ((w[1].i - w[0].i).abs(), (w[1].j - w[0].j).abs());
+            (di, dj) == (2, 1) || (di, dj) == (1, 2)
+        })
+        .count()
+}
+
+#[test]
+fn twenty_neighbourhood_straightens_weighted_search() {
+    // Fig. 9: at ε = 3, N16 zig-zags with knight moves on a straight drive; N20 does not.
+    let p = SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
+    let run = |n: Neighbourhood| {
+        let mut g = DrivingGraph::new(&flat, lattice(120, 64), config(n), goal(100, 20, 0));
+        let r = arastar(&mut g, LatticeState::new(10, 13, 0), &p).expect("valid");
+        r.best().expect("path").path.clone()
+    };
+    let n16 = run(Neighbourhood::N16);
+    let n20 = run(Neighbourhood::N20);
+    assert!(knight_moves(&n16) > 0, "N16 path has no knight moves");
+    assert!(knight_moves(&n20) < knight_moves(&n16), "N20: {} knight moves", knight_moves(&n20));
+}
+
+/// A deterministic rough cost field: 1 to 3, untraversable on ~10 % of the poses
+/// (depending on position and orientation, as the body cost does).
+fn rough(p: &Pose2) -> Option<f64> {
+    let i = (p.x / 0.025).floor() as i64;
+    let j = (p.y / 0.025).floor() as i64;
+    let k = (p.theta * 100.0).round() as i64;
+    let mut h = (i.wrapping_mul(73_856_093)
+        ^ j.wrapping_mul(19_349_663)
+        ^ k.wrapping_mul(83_492_791)) as u64;
+    h ^= h >> 29;
+    h = h.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    h ^= h >> 32;
+    if h.is_multiple_of(10) { None } else { Some(1.0 + (h % 1000) as f64 / 500.0) }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn heuristic_is_consistent(
+        si in 0i16..40, sj in 0i16..40, st in 0u8..16,
+        gi in 0i16..40, gj in 0i16..40, gt in proptest::option::of(0u8..16),
+        n20 in any::<bool>(),
+    ) {
+        let n = if n20 { Neighbourhood::N20 } else { Neighbourhood::N16 };
+        let goal = DrivingGoal { i: gi, j: gj, theta: gt };
+        let mut g = DrivingGraph::new(&rough, lattice(40, 16), config(n), goal);
+        let s = LatticeState::new(si, sj, st);
+        let mut out = Vec::new();
+        g.successors(s, &mut out);
+        let hs = g.heuristic(s);
+        for &(t, c) in &out {
+            prop_assert!(hs <= c + g.heuristic(t), "h({s:?}) = {hs} > {c} + h({t:?})");
+        }
+        prop_assert_eq!(g.heuristic(LatticeState::new(gi, gj, gt.unwrap_or(st))), Cost::ZERO);
+    }
+
+    #[test]
+    fn arastar_ends_at_astar_cost(
+        si in 0i16..30, sj in 0i16..30, gi in 0i16..30, gj in 0i16..30, gt in 0u8..8,
+    ) {
+        let l = lattice(30, 8);
+        let start = LatticeState::new(si, sj, 0);
+        let goal = goal(gi, gj, gt);
+        let mut a = DrivingGraph::new(&rough, l, config(Neighbourhood::N20), goal);
+        let exact = astar(&mut a, start, &SearchParams::default());
+        let mut b = DrivingGraph::new(&rough, l, config(Neighbourhood::N20), goal);
+        let any = arastar(&mut b, start, &SearchParams::default()).expect("valid");
+        prop_assert_eq!(exact.best().map(|s| s.cost), any.best().map(|s| s.cost));
+        if let (Some(first), Some(opt)) = (any.first(), exact.best()) {
+            prop_assert!(first.cost.0 as f64 <= 3.0 * opt.cost.0 as f64);
+        }
+    }
+}
+
+#[test]
+fn plan_driving_snaps_poses_and_reports_off_map() {
+    let l = lattice(60, 64);
+    let cfg = config(Neighbourhood::N20);
+    let r = plan_driving(
+        &flat,
+        l,
+        cfg,
+        &Pose2::new(0.26, 0.26, 0.0),
+        &Pose2::new(1.01, 0.26, 0.0),
+        Algorithm::AraStar,
+        &SearchParams::default(),
+        Default::default(),
+    )
+    .expect("on the map");
+    assert_eq!(r.termination, Termination::OptimalProven);
+    assert_eq!(r.best().map(|s| s.cost), Some(Cost::from_f64(0.75)));
+    let off = plan_driving(
+        &flat,
+        l,
+        cfg,
+        &Pose2::new(-0.5, 0.26, 0.0),
+        &Pose2::new(1.0, 0.26, 0.0),
+        Algorithm::AStar,
+        &SearchParams::default(),
+        Default::default(),
+    );
+    assert!(matches!(off, Err(DrivingPlanError::StartOffMap(_))));
+}
+
+#[test]
+fn cost_maps_adapter_gives_one_on_flat_ground() {
+    use crate::cost::CostMaps;
+    use crate::robot::{Range, RobotDescription};
+    use crate::terrain::HeightMap;
+    let r = Range { min: -2.9, max: 2.9 };
+    let robot = RobotDescription {
+        hips: [
+            [0.35, 0.32, -0.05],
+            [0.35, -0.32, -0.05],
+            [-0.35, 0.32, -0.05],
+            [-0.35, -0.32, -0.05],
+        ],
+        thigh_length: 0.25,
+        shin_length: 0.25,
+        foot_length: 0.10,
+        wheel_radius: 0.08,
+        wheel_track: 0.12,
+        joint_ranges: [r, r, r],
+        neutral_foot_offset_x: [0.0; 4],
+        base_half_extents: [0.45, 0.25, 0.05],
+        base_bottom_z: 0.0,
+        total_mass: 58.0,
+    };
+    let map = HeightMap::filled([0.0, 0.0], 0.025, 120, 120, 0.0).expect("map");
+    let costs = CostMaps::build(&map, &robot, &Params::default()).expect("cost maps");
+    let l = Lattice::for_map(&map, 64).expect("lattice");
+    let centre = l.pose(LatticeState::new(60, 60, 5));
+    let c = costs.driving_cost(&centre).expect("flat ground is traversable");
+    assert!((c - 1.0).abs() < 1e-9, "{c}");
+    // Off the map: no cost.
+    assert_eq!(costs.driving_cost(&Pose2::new(-1.0, 0.0, 0.0)), None);
+    // A drive across the middle of the flat map costs its length.
+    let cfg =
+        DrivingConfig::new(&Params::default(), &robot.neutral_footprint(), Neighbourhood::N16);
+    let mut g = DrivingGraph::new(&costs, l, cfg, goal(80, 60, 0));
+    let r = astar(&mut g, LatticeState::new(40, 60, 0), &SearchParams::default());
+    assert_eq!(r.best().map(|s| s.cost), Some(Cost::from_f64(1.0)));
+}
+
+/// Tests of the hybrid graph (steps, base shifts, foot moves) on rasterised maps with
+/// Momaro's dimensions (as the model gives them).
+mod hybrid {
+    use super::super::hybrid::*;
+    use super::super::*;
+    use crate::cost::CostMaps;
+    use crate::geometry::Pose2;
+    use crate::params::Params;
+    use crate::planner::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
+    use crate::robot::{Leg, Range, RobotDescription};
+    use crate::scenario::terrain::Primitive;
+    use crate::terrain::rasterise;
+
+    fn robot() -> RobotDescription {
+        let r = Range { min: -2.9, max: 2.9 };
+        RobotDescription {
+            hips: [
+                [0.35, 0.32, -0.05],
+                [0.35, -0.32, -0.05],
+                [-0.35, 0.32, -0.05],
+                [-0.35, -0.32, -0.05],
+            ],
+            thigh_length: 0.25,
+            shin_length: 0.25,
+            foot_length: 0.10,
+            wheel_radius: 0.08,
+            wheel_track: 0.12,
+            joint_ranges: [r, r, r],
+            neutral_foot_offset_x: [0.0; 4],
+            base_half_extents: [0.45, 0.25, 0.05],
+            base_bottom_z: 0.0,
+            total_mass: 58.0,
+        }
+    }
+
+    /// A 4 m × 2 m map from (−1, −1) with a platform of `height` from x = 1 m on.
+    fn platform_maps(height: f64) -> CostMaps {
+        let prims = [Primitive::Box { center: [2.0, 0.0], size: [2.0, 2.0], height, yaw_deg: 0.0 }];
+        let m = rasterise(&prims, [-1.0, -1.0], [4.0, 2.0], 0.025).expect("map");
+        CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps")
+    }
+
+    fn graph<'c>(maps: &'c CostMaps, goal: LatticeState) -> HybridGraph<'c> {
+        let cfg = HybridConfig::new(&Params::default(), &robot(), Neighbourhood::N16);
+        HybridGraph::new(maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("graph")
+    }
+
+    fn state_at(g: &HybridGraph<'_>, x: f64, y: f64) -> LatticeState {
+        g.lattice().state(&Pose2::new(x, y, 0.0)).expect("on the map")
+    }
+
+    fn config() -> HybridConfig {
+        HybridConfig::new(&Params::default(), &robot(), Neighbourhood::N16)
+    }
+
+    #[test]
+    fn manoeuvre_costs_by_hand() {
+        let c = config();
+        // eq. 5: 0.5 · 0.45 + 0.1 · (3 − 1) + 2.3 · 0.2 = 0.225 + 0.2 + 0.46.
+        assert!((step_cost(&c, 0.45, 3.0, 0.2) - 0.885).abs() < 1e-12);
+        // C_BS = 0.5 · 0.4 · 1.1.
+        assert!((base_shift_cost(&c, 0.4, 1.1) - 0.22).abs() < 1e-12);
+        // eq. 6: 0.125 · 0.1 · 2.
+        assert!((foot_move_cost(&c, 0.1, 2.0) - 0.025).abs() < 1e-12);
+        assert_eq!(c.step_cost_factor, Params::default().step_cost_factor);
+    }
+
+    #[test]
+    fn reach_comes_from_the_leg_ik() {
+        let maps = platform_maps(0.2);
+        let g = graph(&maps, LatticeState::new(0, 0, 0));
+        // The widest range over all manoeuvre leg heights (0.45 m down by the largest
+        // step, 0.3 m): with the ankle level with the hip (leg 0.18 m) thigh and shin
+        // reach 0.5 m = 20 cells. At 0.45 m the ankle is 0.27 m below the hip:
+        // √(0.5² − 0.27²) = 0.42 m, 16 cells (the base shift test below relies on it).
+        for leg in 0..4 {
+            assert_eq!(g.reach()[leg], [-20, 20], "leg {leg}");
+        }
+    }
+
+    #[test]
+    fn no_steps_far_from_obstacles() {
+        let maps = platform_maps(0.2);
+        let mut g = graph(&maps, LatticeState::new(0, 0, 0));
+        let s = state_at(&g, 0.0, 0.0);
+        let succ = g.labelled_successors(s);
+        assert_eq!(succ.len(), 18, "16 moves and 2 turns");
+        assert!(succ.iter().all(|(_, _, m)| !m.kind.is_step_related()));
+    }
+
+    #[test]
+    fn front_steps_onto_a_platform_cost_eq_5() {
+        let maps = platform_maps(0.2);
+        let mut g = graph(&maps, LatticeState::new(0, 0, 0));
+        // Front feet at x = 0.4875 + 0.35 = 0.8375, 0.1625 m before the edge: within
+        // 0.1 m of the infinite band (0.12 m around the edge cells at 0.9875 / 1.0125).
+        let s = state_at(&g, 0.48, 0.0);
+        let steps: Vec<_> = g
+            .labelled_successors(s)
+            .into_iter()
+            .filter(|(_, _, m)| m.kind == ManoeuvreKind::Step)
+            .collect();
+        let legs: Vec<_> = steps.iter().map(|(_, _, m)| m.leg).collect();
+        assert_eq!(legs, vec![Some(Leg::FrontLeft), Some(Leg::FrontRight)]);
+        for (t, c, m) in &steps {
+            let st = m.step.expect("step details");
+            // The cheapest foothold: flat (C_F = 1) platform, 0.475 m ahead (19 cells,
+            // the reach of a leg 0.2 m shorter), ΔH = 0.2.
+            assert!((st.length_m - 0.475).abs() < 1e-9, "{st:?}");
+            assert_eq!(st.foothold_cost, 1.0);
+            assert!((st.height_m - 0.2).abs() < 1e-12);
+            let c_s = 0.5 * 0.475 + 2.3 * 0.2;
+            assert!((st.c_s - c_s).abs() < 1e-12);
+            let f = Params::default().step_cost_factor;
+            assert_eq!(*c, Cost::from_f64_ceil(f * c_s * (1.0 - 1e-12)));
+            assert_eq!((t.i, t.j, t.theta), (s.i, s.j, s.theta), "the base stays");
+            let o = g.offsets(*t).expect("interned");
+            assert_eq!(o.iter().filter(|&&v| v == 19).count(), 1);
+        }
+    }
+
+    #[test]
+    fn step_height_and_support_criteria() {
+        // Criterion 3: a 0.35 m platform cannot be stepped onto.
+        let maps = platform_maps(0.35);
+        let mut g = graph(&maps, LatticeState::new(0, 0, 0));
+        let s = state_at(&g, 0.48, 0.0);
+        assert!(g.labelled_successors(s).iter().all(|(_, _, m)| m.kind != ManoeuvreKind::Step));
+        // Criterion 4: once the front left foot has stepped 19 cells, the rear left foot
+        // is close to nothing, but the rear feet's support sides are fine; a rear step is
+        // only offered where a rear foot is near the edge. After both front steps, no
+        // further front step exists (the feet are on the flat platform, far from it).
+        let maps = platform_maps(0.2);
+        let mut g = graph(&maps, LatticeState::new(0, 0, 0));
+        let s = state_at(&g, 0.48, 0.0);
+        let fl = g
+            .labelled_successors(s)
+            .into_iter()
+            .find(|(_, _, m)| m.leg == Some(Leg::FrontLeft))
+            .expect("front left step")
+            .0;
+        let after: Vec<_> = g.labelled_successors(fl);
+        assert!(
+            after
+                .iter()
+                .any(|(_, _, m)| m.leg == Some(Leg::FrontRight) && m.kind == ManoeuvreKind::Step)
+        );
+        assert!(
+            after
+                .iter()
+                .all(|(_, _, m)| !(m.leg == Some(Leg::FrontLeft) && m.kind == ManoeuvreKind::Step))
+        );
+    }
+
+    #[test]
+    fn base_shift_after_both_front_steps_costs_c_bs() {
+        let maps = platform_maps(0.2);
+        let mut g = graph(&maps, LatticeState::new(0, 0, 0));
+        let s = state_at(&g, 0.48, 0.0);
+        let fl = g
+            .labelled_successors(s)
+            .into_iter()
+            .find(|(_, _, m)| m.leg == Some(Leg::FrontLeft))
+            .expect("front left step")
+            .0;
+        let both = g
+            .labelled_successors(fl)
+            .into_iter()
+            .find(|(_, _, m)| m.kind == ManoeuvreKind::Step)
+            .expect("front right step")
+            .0;
+        assert_eq!(g.offsets(both), Some([19, 19, 0, 0]));
+        let (t, c, m) = g
+            .labelled_successors(both)
+            .into_iter()
+            .find(|(_, _, m)| m.kind == ManoeuvreKind::BaseShift)
+            .expect("base shift");
+        // Until a rear leg (rear feet on the ground, 0.45 m legs) reaches −0.42 m:
+        // 16 cells, 0.4 m.
+        assert_eq!(g.offsets(t), Some([3, 3, -16, -16]));
+        assert_eq!(t.i - s.i, 16);
+        assert!((m.length_m - 0.4).abs() < 1e-9);
+        // C_B,avg = 1 + k3 · 0.2 = 1.1 (front feet 0.2 m higher; the legs are long
+        // enough that the base clears everything): C_BS = 0.5 · 0.4 · 1.1 = 0.22.
+        let f = Params::default().step_cost_factor;
+        assert!((m.cost - f * 0.22).abs() < 1e-9, "{m:?}");
+        assert_eq!(c, Cost::from_f64_ceil(f * 0.22 * (1.0 - 1e-12)));
+    }
+
+    #[test]
+    fn feet_back_to_neutral_one_at_a_time_cost_eq_6() {
+        let maps = platform_maps(0.2);
+        let mut g = graph(&maps, LatticeState::new(0, 0, 0));
+        let s = state_at(&g, 0.0, 0.0);
+        let t = g.with_offsets(s, [0, 0, -8, -4]).expect("interned");
+        let fms: Vec<_> = g
+            .labelled_successors(t)
+            .into_iter()
+            .filter(|(_, _, m)| m.kind == ManoeuvreKind::FootNeutral)
+            .collect();
+        // Only the first movable foot (RL) is offered; flat ground: C_F,avg = 1.
+        assert_eq!(fms.len(), 1);
+        let (u, _, m) = fms[0];
+        assert_eq!(m.leg, Some(Leg::RearLeft));
+        assert_eq!(g.offsets(u), Some([0, 0, 0, -4]));
+        let f = Params::default().step_cost_factor;
+        assert!((m.cost - f * 0.125 * 0.2 * 1.0).abs() < 1e-12);
+        assert!(g.driving_pose_cost(s).is_some());
+    }
+
+    #[test]
+    fn heuristic_is_consistent_on_every_manoeuvre() {
+        let maps = platform_maps(0.2);
+        let goal = LatticeState::new(120, 40, 0);
+        let mut g = graph(&maps, goal);
+        let mut frontier = vec![state_at(&g, 0.48, 0.0), state_at(&g, 0.3, 0.1)];
+        let mut checked = 0;
+        for _ in 0..6 {
+            let mut next = Vec::new();
+            for s in frontier {
+                for (t, c, m) in g.labelled_successors(s) {
+                    assert!(
+                        g.heuristic(s) <= c.saturating_add(g.heuristic(t)),
+                        "{m:?} from {s:?} to {t:?}"
+                    );
+                    checked += 1;
+                    if m.kind.is_step_related() {
+                        next.push(t);
+                    }
+                }
+            }
+            frontier = next;
+        }
+        assert!(checked > 30, "{checked}");
+    }
+
+    #[test]
+    fn climbs_a_small_platform_and_ara_ends_at_the_astar_cost() {
+        // 3.2 m × 1.6 m: small enough for an exhaustive search.
+        let prims =
+            [Primitive::Box { center: [1.8, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 }];
+        let m = rasterise(&prims, [-0.8, -0.8], [3.2, 1.6], 0.025).expect("map");
+        let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("maps");
+        let g = graph(&maps, LatticeState::new(0, 0, 0));
+        let start = state_at(&g, 0.0, 0.0);
+        let goal = state_at(&g, 1.5, 0.0);
+        let cfg = config();
+        let mut g = HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("g");
+        let a = astar(&mut g, start, &SearchParams::default());
+        assert_eq!(a.termination, Termination::OptimalProven);
+        let best = a.best().expect("a path up");
+        let kinds: Vec<_> =
+            best.path.windows(2).filter_map(|w| g.edge(w[0], w[1]).map(|(_, m)| m.kind)).collect();
+        assert_eq!(kinds.len(), best.path.len() - 1, "every edge is labelled");
+        assert_eq!(kinds.iter().filter(|k| **k == ManoeuvreKind::Step).count(), 4);
+        assert!(kinds.contains(&ManoeuvreKind::BaseShift));
+        let mut g2 = HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("g");
+        let r = arastar(&mut g2, start, &SearchParams::default()).expect("valid params");
+        assert_eq!(r.termination, Termination::OptimalProven);
+        let costs: Vec<_> = r.solutions.iter().map(|s| s.cost).collect();
+        assert!(costs.windows(2).all(|w| w[1] <= w[0]), "{costs:?}");
+        for s in &r.solutions {
+            assert!(s.cost.to_f64() <= s.epsilon * best.cost.to_f64() + 1e-6);
+        }
+        assert_eq!(r.best().map(|s| s.cost), Some(best.cost));
+    }
+}

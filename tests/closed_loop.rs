@@ -1,0 +1,73 @@
+//! The mission in closed loop, driving only: plan, execute in MuJoCo with the B-spline
+//! follower, and check the scenario's expectations with the stability monitor.
+
+mod common;
+
+use momaro::control::path_follower::FollowerConfig;
+use momaro::jobs::plan::PlanOptions;
+use momaro::jobs::run::{PoseNoise, RunOptions, RunSummary, run};
+
+fn run_scenario(name: &str, noise: Option<PoseNoise>) -> RunSummary {
+    let sc = common::scenario(name);
+    // A generous planning budget: CI machines are slow and this is not a speed test.
+    let plan = PlanOptions { time_limit_s: 60.0, ..PlanOptions::default() };
+    let opts = RunOptions {
+        plan,
+        follower: FollowerConfig::default(),
+        model_path: common::model(),
+        rerun: None,
+        progress: false,
+        noise,
+    };
+    let s = run(&sc, &opts).expect("run completes");
+    assert!(s.passed, "{name}: expectations failed: {s:#?}");
+    assert!(
+        s.min_stability_margin_m > 0.0 && !s.tipped && s.body_collisions.is_empty(),
+        "{name}: {s:#?}"
+    );
+    s
+}
+
+#[test]
+fn flat_goal_behind_and_beside_is_reached_within_5cm_and_5deg() {
+    let s = run_scenario("flat", None);
+    assert!(s.goal_position_error_m < 0.05, "{s:#?}");
+    assert!(s.goal_heading_error_rad.abs() < 5f64.to_radians(), "{s:#?}");
+}
+
+#[test]
+fn flat_with_seeded_pose_noise_still_reaches_the_goal() {
+    let noise = PoseNoise { position_std_m: 0.01, yaw_std_rad: 1f64.to_radians(), seed: 7 };
+    let s = run_scenario("flat", Some(noise));
+    assert!(s.goal_position_error_m < 0.05, "{s:#?}");
+}
+
+#[test]
+fn poles_drives_over_the_low_pole_and_around_the_tall_one_without_touching() {
+    // The plan takes the low pole between the legs (tests/planner_scenarios.rs); here the
+    // executed run must do it without any body touching a pole.
+    let s = run_scenario("poles", None);
+    assert_eq!(s.plan_steps, 0);
+    assert!(s.goal_position_error_m < 0.1);
+}
+
+#[test]
+fn narrow_corridor_is_driven_sideways() {
+    let s = run_scenario("corridor", None);
+    assert!(s.goal_position_error_m < 0.1, "{s:#?}");
+    // The corridor is too narrow to turn in: the heading never leaves the start's much.
+    assert!(s.goal_heading_error_rad.abs() < 5f64.to_radians());
+}
+
+#[test]
+fn ramp_detour_drives_up_the_ramp_with_the_pitch_following_the_slope() {
+    let s = run_scenario("ramp_detour", None);
+    assert_eq!(s.plan_steps, 0, "the detour must win over stepping");
+    // Ramp: 0.2 m over 1.5 m, slope 7.6°; the base pitches by 70 % of it (Sec. VI-B).
+    let expected = 0.7 * (0.2f64 / 1.5).atan().to_degrees();
+    assert!(
+        (s.max_pitch_deg - expected).abs() < 1.5,
+        "max pitch {} vs {expected}",
+        s.max_pitch_deg
+    );
+}
