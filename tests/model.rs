@@ -107,3 +107,30 @@ fn urdf_is_in_sync_with_the_mjcf() {
         );
     }
 }
+
+#[test]
+fn scratch_com_matches_the_simulated_com_and_leaves_the_simulation_alone() {
+    let mut sim = Simulation::robot_only(&common::model()).expect("model compiles");
+    let q = [[0.9, -1.8, 0.9], [0.9, -1.8, 0.9], [-0.9, 1.8, -0.9], [-0.9, 1.8, -0.9]];
+    sim.place_robot([0.3, -0.2, 0.6], 0.4, &q);
+    let simulated = sim.center_of_mass();
+    let before = sim.base().position;
+    let scratch = sim.com_of_configuration([0.3, -0.2, 0.6], [0.0, 0.0, 0.4], &q);
+    for k in 0..3 {
+        assert!((scratch[k] - simulated[k]).abs() < 1e-9, "{scratch:?} vs {simulated:?}");
+    }
+    assert_eq!(sim.base().position, before);
+    // Rotating only the base rotates the CoM rigidly about the base origin: pitch by −0.2
+    // rad (nose up) about the base's y axis, after the yaw of 0.4 rad.
+    let pitched = sim.com_of_configuration([0.3, -0.2, 0.6], [0.0, -0.2, 0.4], &q);
+    let rel = |c: [f64; 3]| [c[0] - 0.3, c[1] + 0.2, c[2] - 0.6];
+    let (sy, cy) = 0.4f64.sin_cos();
+    let to_base = |v: [f64; 3]| [cy * v[0] + sy * v[1], -sy * v[0] + cy * v[1], v[2]];
+    let level = to_base(rel(scratch));
+    let (sp, cp) = (-0.2f64).sin_cos();
+    let expected = [cp * level[0] + sp * level[2], level[1], -sp * level[0] + cp * level[2]];
+    let got = to_base(rel(pitched));
+    for k in 0..3 {
+        assert!((got[k] - expected[k]).abs() < 1e-9, "{got:?} vs {expected:?}");
+    }
+}

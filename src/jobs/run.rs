@@ -49,6 +49,9 @@ pub enum RunJobError {
     /// The height map could not be built.
     #[error(transparent)]
     Costmap(#[from] super::costmap::CostmapError),
+    /// The cost layers for the recording could not be built.
+    #[error(transparent)]
+    Cost(#[from] crate::cost::CostError),
     /// The follower rejected the path or its configuration.
     #[error("path follower: {0}")]
     Follower(#[from] FollowerError),
@@ -304,6 +307,12 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
             let mut r = Recorder::create(path, "momaro run")?;
             r.log_world(&sim.geom_shapes(), &sim.body_poses())?;
             r.log_height_map(&heights)?;
+            let maps = crate::cost::CostMaps::build(&heights, &robot, params)?;
+            let (nx, ny) = heights.dims();
+            let foot: Vec<_> = (0..nx * ny).map(|k| maps.foot_cost_cell(k % nx, k / nx)).collect();
+            if let Some(img) = crate::cost_image::cost_layer_image(&foot, nx, ny, None) {
+                r.log_layer_image("foot_cost", &img, heights.origin(), heights.resolution())?;
+            }
             r.log_plan(&poses)?;
             Some(r)
         }

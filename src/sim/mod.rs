@@ -157,6 +157,8 @@ pub struct Simulation {
     base_qpos: usize,
     base_qvel: usize,
     terrain_geoms: Vec<bool>,
+    /// Scratch data for kinematic queries that must not disturb the simulation.
+    scratch: Option<MjData<Arc<MjModel>>>,
 }
 
 impl std::fmt::Debug for Simulation {
@@ -256,7 +258,17 @@ impl Simulation {
             })
             .collect();
         let data = MjData::new(model.clone());
-        Ok(Self { model, data, robot, legs, base_body, base_qpos, base_qvel, terrain_geoms })
+        Ok(Self {
+            model,
+            data,
+            robot,
+            legs,
+            base_body,
+            base_qpos,
+            base_qvel,
+            terrain_geoms,
+            scratch: None,
+        })
     }
 
     /// The robot's description, read from the compiled model.
@@ -564,6 +576,57 @@ impl Simulation {
     pub fn urdf_inputs(&self) -> Result<crate::urdf_export::UrdfInputs, SimError> {
         model::urdf_inputs(&self.model)
     }
+}
+
+impl Simulation {
+    /// The whole robot's CoM (world frame, m) for a commanded configuration, computed by
+    /// MuJoCo's own kinematics (`mj_kinematics`, `mj_comPos`, subtree CoM of the base) on a
+    /// scratch copy of the data, so planned and simulated CoM agree by construction. The
+    /// running simulation is not touched. Base orientation from roll, pitch, yaw (ZYX);
+    /// steering and wheel angles at zero (they do not move the CoM of a symmetric pair).
+    pub fn com_of_configuration(
+        &mut self,
+        base_position: [f64; 3],
+        base_rpy: [f64; 3],
+        leg_joints: &[[f64; 3]; 4],
+    ) -> [f64; 3] {
+        let scratch = self.scratch.get_or_insert_with(|| MjData::new(self.model.clone()));
+        let q = rpy_to_quaternion(base_rpy);
+        let bq = self.base_qpos;
+        let legs = self.legs;
+        let qpos = scratch.qpos_mut();
+        qpos.fill(0.0);
+        qpos[bq..bq + 7].copy_from_slice(&[
+            base_position[0],
+            base_position[1],
+            base_position[2],
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+        ]);
+        for (ids, joints) in legs.iter().zip(leg_joints) {
+            for k in 0..3 {
+                qpos[ids.qpos[k]] = joints[k];
+            }
+        }
+        scratch.kinematics();
+        scratch.com_pos();
+        scratch.subtree_com()[self.base_body]
+    }
+}
+
+/// Unit quaternion (w, x, y, z) of roll, pitch, yaw (ZYX: R = Rz(yaw)·Ry(pitch)·Rx(roll)).
+pub fn rpy_to_quaternion(rpy: [f64; 3]) -> [f64; 4] {
+    let (sr, cr) = (rpy[0] / 2.0).sin_cos();
+    let (sp, cp) = (rpy[1] / 2.0).sin_cos();
+    let (sy, cy) = (rpy[2] / 2.0).sin_cos();
+    [
+        cr * cp * cy + sr * sp * sy,
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+    ]
 }
 
 /// Range beyond which the laser reports nothing, m (MuJoCo's ray cut-off).
