@@ -155,16 +155,23 @@ fn staircase_climbs_then_takes_the_bar_between_its_legs() {
     let top = &p.path[last_step];
     assert!(top.foot_heights.iter().all(|h| h.is_some_and(|h| h > 0.3)));
     assert!(p.path[last_step + 1..].iter().all(|e| !matches!(e.kind, PathKind::Step)));
-    // Driving over the landing, some pose takes the bar (x = 3.7 m, y from −0.3 m)
-    // between its legs: two wheels on each side of it, the base above it. (With k12 = 2
-    // the optimal plan turns to drive forward along the bar and turns back at the goal,
-    // rather than crab the whole way as in the paper's Fig. 12.)
-    let straddles = p.path.iter().any(|e| {
-        e.pose.y > -0.2
-            && e.feet.iter().filter(|f| f[0] > 3.8).count() == 2
-            && e.feet.iter().filter(|f| f[0] < 3.6).count() == 2
-    });
-    assert!(straddles, "never takes the bar between its legs");
+    // The landing is too shallow to turn on, so along the bar (x = 3.45 m, y from
+    // −0.5 m; checked from y = 0, once the robot has squared up) the robot drives sideways as in the paper's Fig. 12: heading along +x, moving
+    // along +y, front wheels beyond the bar and rear wheels before it.
+    let straddling: Vec<_> = p.path[last_step + 1..]
+        .iter()
+        .filter(|e| {
+            e.pose.y > 0.0
+                && e.feet.iter().filter(|f| f[0] > 3.55).count() == 2
+                && e.feet.iter().filter(|f| f[0] < 3.35).count() == 2
+        })
+        .collect();
+    assert!(straddling.len() >= 10, "never takes the bar between its legs");
+    let (first, last) = (straddling[0], straddling[straddling.len() - 1]);
+    assert!(last.pose.y - first.pose.y > 0.5, "drives along the bar: {:?} → {:?}", first.pose, last.pose);
+    for e in &straddling {
+        assert!(e.pose.theta.abs() < 10f64.to_radians(), "sideways, not turned: {:?}", e.pose);
+    }
 }
 
 #[test]
