@@ -11,25 +11,13 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use momaro::cost::{CostMaps, FootCostLayer};
 use momaro::geometry::Pose2;
 use momaro::params::Params;
-use momaro::robot::{Range, RobotDescription};
+use momaro::robot::RobotDescription;
 use momaro::scenario::terrain::Primitive;
 use momaro::terrain::{HeightMap, rasterise};
 
 /// Test robot with Momaro-like proportions (the real numbers come from the model).
 fn robot() -> RobotDescription {
-    RobotDescription {
-        hips: [[0.3, 0.2, 0.0], [0.3, -0.2, 0.0], [-0.3, 0.2, 0.0], [-0.3, -0.2, 0.0]],
-        thigh_length: 0.3,
-        shin_length: 0.3,
-        foot_length: 0.1,
-        wheel_radius: 0.08,
-        wheel_track: 0.1,
-        joint_ranges: [Range { min: -2.0, max: 2.0 }; 3],
-        neutral_foot_offset_x: [0.15, 0.15, -0.15, -0.15],
-        base_half_extents: [0.45, 0.25, 0.1],
-        base_bottom_z: -0.05,
-        total_mass: 50.0,
-    }
+    RobotDescription::reference()
 }
 
 /// xorshift64: a fixed pseudo-random sequence, so the scene is the same every run.

@@ -228,7 +228,7 @@ pub fn write_png(image: &RgbImage, path: &Path) -> Result<(), ImageError> {
 mod tests {
     use super::*;
     use crate::params::Params;
-    use crate::robot::{Range, RobotDescription};
+    use crate::robot::RobotDescription;
     use crate::scenario::terrain::Primitive;
     use crate::terrain::rasterise;
 
@@ -297,19 +297,7 @@ mod tests {
         for j in 100..120 {
             m.set(10, j, f64::NAN).unwrap();
         }
-        let robot = RobotDescription {
-            hips: [[0.3, 0.2, 0.0], [0.3, -0.2, 0.0], [-0.3, 0.2, 0.0], [-0.3, -0.2, 0.0]],
-            thigh_length: 0.3,
-            shin_length: 0.3,
-            foot_length: 0.1,
-            wheel_radius: 0.08,
-            wheel_track: 0.1,
-            joint_ranges: [Range { min: -2.0, max: 2.0 }; 3],
-            neutral_foot_offset_x: [0.15, 0.15, -0.15, -0.15],
-            base_half_extents: [0.45, 0.25, 0.1],
-            base_bottom_z: -0.05,
-            total_mass: 50.0,
-        };
+        let robot = RobotDescription::reference();
         let maps = CostMaps::build(&m, &robot, &Params::default()).unwrap();
         write_height_png(&m, &tmp("h.png")).unwrap();
         write_foot_cost_png(&maps, None, &tmp("f.png")).unwrap();

@@ -134,3 +134,33 @@ fn scratch_com_matches_the_simulated_com_and_leaves_the_simulation_alone() {
         assert!((got[k] - expected[k]).abs() < 1e-9, "{got:?} vs {expected:?}");
     }
 }
+
+#[test]
+fn reference_description_for_unit_tests_equals_the_model() {
+    let sim = Simulation::robot_only(&common::model()).expect("model compiles");
+    let got = sim.robot();
+    let reference = momaro::robot::RobotDescription::reference();
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+    for i in 0..4 {
+        for k in 0..3 {
+            assert!(close(got.hips[i][k], reference.hips[i][k]), "hips");
+        }
+        assert!(close(got.neutral_foot_offset_x[i], reference.neutral_foot_offset_x[i]));
+    }
+    for (a, b) in [
+        (got.thigh_length, reference.thigh_length),
+        (got.shin_length, reference.shin_length),
+        (got.foot_length, reference.foot_length),
+        (got.wheel_radius, reference.wheel_radius),
+        (got.wheel_track, reference.wheel_track),
+        (got.base_bottom_z, reference.base_bottom_z),
+        (got.total_mass, reference.total_mass),
+    ] {
+        assert!(close(a, b), "{a} vs {b}: update RobotDescription::reference()");
+    }
+    for k in 0..3 {
+        assert!(close(got.base_half_extents[k], reference.base_half_extents[k]));
+        assert!(close(got.joint_ranges[k].min, reference.joint_ranges[k].min));
+        assert!(close(got.joint_ranges[k].max, reference.joint_ranges[k].max));
+    }
+}

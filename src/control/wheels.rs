@@ -139,28 +139,10 @@ impl WheelKinematics {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::robot::Range;
 
+    /// Round numbers for hand-computed speeds: r = 0.1 m, track 0.2 m.
     fn robot() -> RobotDescription {
-        let r = Range { min: -2.9, max: 2.9 };
-        RobotDescription {
-            hips: [
-                [0.35, 0.32, -0.05],
-                [0.35, -0.32, -0.05],
-                [-0.35, 0.32, -0.05],
-                [-0.35, -0.32, -0.05],
-            ],
-            thigh_length: 0.25,
-            shin_length: 0.25,
-            foot_length: 0.10,
-            wheel_radius: 0.1,
-            wheel_track: 0.2,
-            joint_ranges: [r, r, r],
-            neutral_foot_offset_x: [0.0; 4],
-            base_half_extents: [0.45, 0.25, 0.05],
-            base_bottom_z: 0.0,
-            total_mass: 58.0,
-        }
+        RobotDescription { wheel_radius: 0.1, wheel_track: 0.2, ..RobotDescription::reference() }
     }
 
     const K: WheelKinematics =

@@ -223,27 +223,9 @@ fn plan_driving_snaps_poses_and_reports_off_map() {
 #[test]
 fn cost_maps_adapter_gives_one_on_flat_ground() {
     use crate::cost::CostMaps;
-    use crate::robot::{Range, RobotDescription};
+    use crate::robot::RobotDescription;
     use crate::terrain::HeightMap;
-    let r = Range { min: -2.9, max: 2.9 };
-    let robot = RobotDescription {
-        hips: [
-            [0.35, 0.32, -0.05],
-            [0.35, -0.32, -0.05],
-            [-0.35, 0.32, -0.05],
-            [-0.35, -0.32, -0.05],
-        ],
-        thigh_length: 0.25,
-        shin_length: 0.25,
-        foot_length: 0.10,
-        wheel_radius: 0.08,
-        wheel_track: 0.12,
-        joint_ranges: [r, r, r],
-        neutral_foot_offset_x: [0.0; 4],
-        base_half_extents: [0.45, 0.25, 0.05],
-        base_bottom_z: 0.0,
-        total_mass: 58.0,
-    };
+    let robot = RobotDescription::reference();
     let map = HeightMap::filled([0.0, 0.0], 0.025, 120, 120, 0.0).expect("map");
     let costs = CostMaps::build(&map, &robot, &Params::default()).expect("cost maps");
     let l = Lattice::for_map(&map, 64).expect("lattice");
@@ -269,30 +251,12 @@ mod hybrid {
     use crate::geometry::Pose2;
     use crate::params::Params;
     use crate::planner::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
-    use crate::robot::{Leg, Range, RobotDescription};
+    use crate::robot::{Leg, RobotDescription};
     use crate::scenario::terrain::Primitive;
     use crate::terrain::rasterise;
 
     fn robot() -> RobotDescription {
-        let r = Range { min: -2.9, max: 2.9 };
-        RobotDescription {
-            hips: [
-                [0.35, 0.32, -0.05],
-                [0.35, -0.32, -0.05],
-                [-0.35, 0.32, -0.05],
-                [-0.35, -0.32, -0.05],
-            ],
-            thigh_length: 0.25,
-            shin_length: 0.25,
-            foot_length: 0.10,
-            wheel_radius: 0.08,
-            wheel_track: 0.12,
-            joint_ranges: [r, r, r],
-            neutral_foot_offset_x: [0.0; 4],
-            base_half_extents: [0.45, 0.25, 0.05],
-            base_bottom_z: 0.0,
-            total_mass: 58.0,
-        }
+        RobotDescription::reference()
     }
 
     /// A 4 m × 2 m map from (−1, −1) with a platform of `height` from x = 1 m on.

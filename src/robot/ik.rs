@@ -112,28 +112,9 @@ pub fn leg_fk(robot: &RobotDescription, q: [f64; 3], pitch: f64) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::robot::Range;
 
     fn robot() -> RobotDescription {
-        let r = Range { min: -2.9, max: 2.9 };
-        RobotDescription {
-            hips: [
-                [0.35, 0.32, -0.05],
-                [0.35, -0.32, -0.05],
-                [-0.35, 0.32, -0.05],
-                [-0.35, -0.32, -0.05],
-            ],
-            thigh_length: 0.25,
-            shin_length: 0.25,
-            foot_length: 0.10,
-            wheel_radius: 0.08,
-            wheel_track: 0.12,
-            joint_ranges: [r, r, r],
-            neutral_foot_offset_x: [0.0; 4],
-            base_half_extents: [0.45, 0.25, 0.05],
-            base_bottom_z: 0.0,
-            total_mass: 58.0,
-        }
+        RobotDescription::reference()
     }
 
     #[test]

@@ -107,6 +107,31 @@ pub struct RobotDescription {
 }
 
 impl RobotDescription {
+    /// Momaro as `models/momaro.xml` compiles, written out for unit tests and benchmarks
+    /// that run without MuJoCo. Library code never uses it: it reads the model. The test
+    /// `tests/model.rs` checks it equals what the model gives, so it cannot drift.
+    pub fn reference() -> Self {
+        let joint = Range { min: -2.9, max: 2.9 };
+        Self {
+            hips: [
+                [0.35, 0.32, -0.05],
+                [0.35, -0.32, -0.05],
+                [-0.35, 0.32, -0.05],
+                [-0.35, -0.32, -0.05],
+            ],
+            thigh_length: 0.25,
+            shin_length: 0.25,
+            foot_length: 0.10,
+            wheel_radius: 0.08,
+            wheel_track: 0.12,
+            joint_ranges: [joint; 3],
+            neutral_foot_offset_x: [0.0; 4],
+            base_half_extents: [0.45, 0.25, 0.05],
+            base_bottom_z: 0.0,
+            total_mass: 58.0,
+        }
+    }
+
     /// Neutral foot positions (x', y') in the base frame, per leg.
     pub fn neutral_footprint(&self) -> [[f64; 2]; 4] {
         std::array::from_fn(|i| [self.hips[i][0] + self.neutral_foot_offset_x[i], self.hips[i][1]])
