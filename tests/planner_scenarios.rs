@@ -156,8 +156,9 @@ fn staircase_climbs_then_takes_the_bar_between_its_legs() {
     assert!(top.foot_heights.iter().all(|h| h.is_some_and(|h| h > 0.3)));
     assert!(p.path[last_step + 1..].iter().all(|e| !matches!(e.kind, PathKind::Step)));
     // The landing is too shallow to turn on, so along the bar (x = 3.45 m, y from
-    // −0.5 m; checked from y = 0, once the robot has squared up) the robot drives sideways as in the paper's Fig. 12: heading along +x, moving
-    // along +y, front wheels beyond the bar and rear wheels before it.
+    // −0.5 m; checked from y = 0, once the robot has squared up) the robot drives sideways
+    // as in the paper's Fig. 12: heading along +x, moving along +y, front wheels beyond the
+    // bar and rear wheels before it.
     let straddling: Vec<_> = p.path[last_step + 1..]
         .iter()
         .filter(|e| {
@@ -168,7 +169,12 @@ fn staircase_climbs_then_takes_the_bar_between_its_legs() {
         .collect();
     assert!(straddling.len() >= 10, "never takes the bar between its legs");
     let (first, last) = (straddling[0], straddling[straddling.len() - 1]);
-    assert!(last.pose.y - first.pose.y > 0.5, "drives along the bar: {:?} → {:?}", first.pose, last.pose);
+    assert!(
+        last.pose.y - first.pose.y > 0.5,
+        "drives along the bar: {:?} → {:?}",
+        first.pose,
+        last.pose
+    );
     for e in &straddling {
         assert!(e.pose.theta.abs() < 10f64.to_radians(), "sideways, not turned: {:?}", e.pose);
     }
