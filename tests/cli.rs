@@ -210,3 +210,45 @@ fn closed_stdout_is_not_a_panic() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(out.status.success(), "{stderr}");
 }
+
+#[test]
+fn run_recording_verifies_with_rerun_and_json_has_the_documented_fields() {
+    let rerun = common::root().join("third_party/venv/bin/rerun");
+    assert!(rerun.is_file(), "the Rerun CLI is missing: run `tools/setup --rerun-cli`");
+    let dir = common::temp_dir("run_rrd");
+    let rrd = dir.join("corridor.rrd");
+    let scenario = common::root().join("scenarios/corridor.toml");
+    let out =
+        momaro(&["run", scenario.to_str().unwrap(), "--json", "--rerun", rrd.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    for key in [
+        "reached_goal",
+        "goal_position_error_m",
+        "goal_heading_error_rad",
+        "sim_time_s",
+        "wall_time_s",
+        "real_time_factor",
+        "min_stability_margin_m",
+        "tipped",
+        "body_collisions",
+        "steps_executed",
+        "planning_time_s",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}: {v}");
+    }
+    let verify = Command::new(&rerun)
+        .args(["rrd", "verify", rrd.to_str().unwrap()])
+        .output()
+        .expect("rerun runs");
+    assert!(verify.status.success(), "{}", String::from_utf8_lossy(&verify.stderr));
+}
+
+#[test]
+fn run_of_a_stepping_plan_fails_clearly_not_silently() {
+    let scenario = common::root().join("scenarios/ramp_far.toml");
+    let out = momaro(&["run", scenario.to_str().unwrap(), "--time-limit", "60"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("steps") && stderr.contains("not implemented"), "{stderr}");
+}
