@@ -90,6 +90,9 @@ pub enum Command {
         /// Print the result as JSON.
         #[arg(long)]
         json: bool,
+        /// Expand the path into stable keyframes (step motion generation, Sec. VI).
+        #[arg(long)]
+        detailed: bool,
         #[command(flatten)]
         model: ModelArgs,
     },
@@ -395,7 +398,36 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             }
             Ok(true)
         }
-        Command::Plan { scenario, planner, rerun, json, model } => {
+        Command::Plan { scenario, planner, rerun, json, detailed: true, model } => {
+            let sc = load(&scenario)?;
+            let mut sim = crate::sim::Simulation::robot_only(&model.model)?;
+            let d =
+                jobs::detailed::run(&sc, &mut sim, &planner.options()).map_err(|e| match e {
+                    jobs::detailed::DetailedJobError::Plan(p) => plan_error(p),
+                    other => anyhow::Error::new(other),
+                })?;
+            if let Some(path) = rerun {
+                jobs::detailed::record(&sc, &d, &path)
+                    .with_context(|| format!("recording {}", path.display()))?;
+            }
+            if json {
+                print_json(&d)?;
+            } else {
+                let k = &d.detailed;
+                say!("scenario            {} ({})", d.plan.scenario, d.plan.algorithm);
+                say!("path                {} poses, {} steps", d.plan.path.len(), d.plan.steps);
+                say!("keyframes           {} over {:.1} s", k.keyframes.len(), k.duration_s);
+                say!(
+                    "min margin          {:.3} m (keyframes {:.3} m, three contacts {:.3} m)",
+                    k.min_margin_m,
+                    k.min_keyframe_margin_m,
+                    k.min_three_contact_margin_m
+                );
+                say!("postures checked    {}", k.samples_checked);
+            }
+            Ok(true)
+        }
+        Command::Plan { scenario, planner, rerun, json, detailed: false, model } => {
             let sc = load(&scenario)?;
             let robot = robot(&model.model)?;
             let summary = jobs::plan::run(&sc, &robot, &planner.options()).map_err(plan_error)?;

@@ -10,6 +10,7 @@ pub mod geometry;
 pub mod jobs;
 pub mod locomotion;
 pub mod monitor;
+pub mod motion;
 pub mod params;
 pub mod planner;
 pub mod progress;

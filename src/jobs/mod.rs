@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod costmap;
+pub mod detailed;
 pub mod plan;
 pub mod plan_recording;
 pub mod run;

@@ -663,3 +663,16 @@ impl RayCaster for Simulation {
         }
     }
 }
+
+/// The step motion generator's CoM model: MuJoCo's own kinematics on a scratch copy of the
+/// data ([`Simulation::com_of_configuration`]), so planned and simulated CoM agree.
+impl crate::motion::CenterOfMassModel for Simulation {
+    fn com(
+        &mut self,
+        base_position: [f64; 3],
+        base_rpy: [f64; 3],
+        legs: &[[f64; 3]; 4],
+    ) -> [f64; 3] {
+        self.com_of_configuration(base_position, base_rpy, legs)
+    }
+}

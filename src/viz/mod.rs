@@ -380,3 +380,87 @@ impl Recorder {
         self.rec.flush_blocking().map_err(|e| self.err(e))
     }
 }
+
+impl Recorder {
+    /// Logs the keyframes of a detailed path (step motion generation) on the `sim_time`
+    /// timeline at their times: the base origin under `world/keyframes/base`, the feet
+    /// (in contact green, lifted red) under `world/keyframes/feet`, the support polygon and
+    /// the CoM's ground projection under `world/keyframes/support` and `…/com`, the expected
+    /// margin under `plots/keyframe_margin_m`, and the phase name as a text log.
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_keyframes(&self, keyframes: &[crate::motion::Keyframe]) -> Result<(), VizError> {
+        for k in keyframes {
+            self.rec.set_duration_secs(SIM_TIME, k.time_s);
+            self.rec
+                .log(
+                    "world/keyframes/base",
+                    &rerun::Points3D::new([v3(k.base_position)])
+                        .with_radii([0.03])
+                        .with_colors([rerun::Color::from_rgb(230, 120, 20)]),
+                )
+                .map_err(|e| self.err(e))?;
+            let colors: Vec<rerun::Color> = k
+                .contact
+                .iter()
+                .map(|&c| {
+                    if c {
+                        rerun::Color::from_rgb(40, 200, 60)
+                    } else {
+                        rerun::Color::from_rgb(230, 40, 40)
+                    }
+                })
+                .collect();
+            self.rec
+                .log(
+                    "world/keyframes/feet",
+                    &rerun::Points3D::new(k.feet.iter().map(|f| v3(*f)))
+                        .with_radii([0.04])
+                        .with_colors(colors),
+                )
+                .map_err(|e| self.err(e))?;
+            let ground = k
+                .feet
+                .iter()
+                .zip(k.contact)
+                .filter(|(_, c)| *c)
+                .map(|(f, _)| f[2])
+                .fold(f64::INFINITY, f64::min);
+            let z = if ground.is_finite() { ground as f32 + 0.01 } else { 0.01 };
+            let support: Vec<[f64; 2]> = k
+                .feet
+                .iter()
+                .zip(k.contact)
+                .filter(|(_, c)| *c)
+                .map(|(f, _)| [f[0], f[1]])
+                .collect();
+            let mut ring: Vec<[f32; 3]> = crate::stability::convex_hull(&support)
+                .iter()
+                .map(|p| [p[0] as f32, p[1] as f32, z])
+                .collect();
+            if let Some(first) = ring.first().copied() {
+                ring.push(first);
+            }
+            self.rec
+                .log("world/keyframes/support", &rerun::LineStrips3D::new([ring]))
+                .map_err(|e| self.err(e))?;
+            self.rec
+                .log(
+                    "world/keyframes/com",
+                    &rerun::Points3D::new([[k.com[0] as f32, k.com[1] as f32, z], v3(k.com)])
+                        .with_radii([0.02]),
+                )
+                .map_err(|e| self.err(e))?;
+            if k.margin_m.is_finite() {
+                self.rec
+                    .log("plots/keyframe_margin_m", &rerun::Scalars::single(k.margin_m))
+                    .map_err(|e| self.err(e))?;
+            }
+            self.rec
+                .log("world/keyframes/phase", &rerun::TextLog::new(k.phase.name()))
+                .map_err(|e| self.err(e))?;
+        }
+        Ok(())
+    }
+}

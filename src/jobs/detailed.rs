@@ -1,0 +1,83 @@
+//! `momaro plan --detailed`: plan, then expand the abstract path into stable keyframes
+//! (step motion generation, Sec. VI) with MuJoCo's CoM.
+
+use super::plan::{self, PlanJobError, PlanOptions, PlanSummary};
+use crate::motion::{DetailedPath, MotionError, MotionOptions, expand_path};
+use crate::scenario::Scenario;
+use crate::sim::Simulation;
+use serde::Serialize;
+
+/// Why a detailed plan failed.
+#[derive(Debug, thiserror::Error)]
+pub enum DetailedJobError {
+    /// Planning failed.
+    #[error(transparent)]
+    Plan(#[from] PlanJobError),
+    /// The expansion failed.
+    #[error("scenario {scenario}: step motion generation")]
+    Motion {
+        /// Scenario name.
+        scenario: String,
+        /// The cause.
+        source: MotionError,
+    },
+}
+
+/// A plan and its expansion: what `momaro plan --detailed --json` prints.
+#[derive(Debug, Clone, Serialize)]
+pub struct DetailedSummary {
+    /// The abstract plan.
+    pub plan: PlanSummary,
+    /// The expanded path.
+    pub detailed: DetailedPath,
+}
+
+/// Plans `scenario` and expands the path, with the CoM of `sim`'s model.
+///
+/// # Errors
+/// [`DetailedJobError`] if planning or the expansion fails.
+pub fn run(
+    scenario: &Scenario,
+    sim: &mut Simulation,
+    opts: &PlanOptions,
+) -> Result<DetailedSummary, DetailedJobError> {
+    let robot = sim.robot().clone();
+    let plan = plan::run(scenario, &robot, opts)?;
+    let detailed = expand(scenario, sim, &plan)?;
+    Ok(DetailedSummary { plan, detailed })
+}
+
+/// Expands an existing plan of `scenario`.
+///
+/// # Errors
+/// [`DetailedJobError`] if the maps cannot be built or the expansion fails.
+pub fn expand(
+    scenario: &Scenario,
+    sim: &mut Simulation,
+    plan: &PlanSummary,
+) -> Result<DetailedPath, DetailedJobError> {
+    let robot = sim.robot().clone();
+    let prep = plan::prepare(scenario, &robot, Some(plan.k12), Some(plan.step_cost_factor))?;
+    let options = MotionOptions::from_params(&prep.params);
+    expand_path(&plan.path, &robot, &prep.maps, sim, &options)
+        .map_err(|source| DetailedJobError::Motion { scenario: scenario.name.clone(), source })
+}
+
+/// Writes a recording of the detailed plan: height map, abstract path and keyframes.
+///
+/// # Errors
+/// If the map cannot be rebuilt or writing fails.
+pub fn record(
+    scenario: &Scenario,
+    summary: &DetailedSummary,
+    path: &std::path::Path,
+) -> Result<(), super::plan_recording::PlanRecordingError> {
+    let heights = super::costmap::rasterised_map(scenario)?;
+    let rec = crate::viz::Recorder::create(path, "momaro plan --detailed")?;
+    rec.log_height_map(&heights)?;
+    let poses: Vec<_> = summary.plan.path.iter().map(|e| e.pose).collect();
+    rec.log_plan(&poses)?;
+    rec.log_keyframes(&summary.detailed.keyframes)?;
+    rec.finish()?;
+    Ok(())
+}

@@ -1,0 +1,850 @@
+//! The expansion of an abstract path into keyframes (Sec. VI).
+//!
+//! Walking the abstract path (`jobs::plan::PathElement`s), the expander keeps the robot's
+//! actual posture (base pose and the four feet) and appends keyframes:
+//!
+//! - **Driving** (drive / turn elements): one keyframe per path pose, feet in the neutral
+//!   footprint on the height map. At driving height (0.27 m) the mean hip stands that high
+//!   above the mean ground under the feet (as `jobs::run::driving_leg_targets`); while
+//!   standing (between close manoeuvres) the manoeuvre leg-height rule below applies. The
+//!   base pitch is 70 % of the ground slope between front and rear feet (Sec. VI-B).
+//! - **Stand up / lower** (Fig. 13b, n): before the first non-driving manoeuvre the robot
+//!   stands up; it lowers to driving height when the footprint is neutral and the next
+//!   manoeuvre is at least [`MotionOptions::stay_standing_m`] of driving away (or none).
+//! - **Leg heights while standing** (Sec. VI-B): the base height is set by the highest
+//!   foot, whose leg gets the manoeuvre height (0.45 m, a soft constraint); the others are
+//!   longer. When a leg would then exceed its reach (hard constraint), the leg height is
+//!   lowered in 1 cm steps (down to the driving height).
+//! - **Planned base shifts and wheel moves** (Sec. V, Fig. 6b–d): one keyframe each, all
+//!   feet in contact.
+//! - **Abstract steps** (Sec. VI-A, Fig. 12, 13c–g): `roll` (eqs. 6–8 toward the support
+//!   triangle centroid's lateral coordinate, iterated with the CoM model because the base
+//!   actually turns about the lower side's hips rather than about R, and capped at
+//!   [`MotionOptions::max_roll_rad`]), `wheel_to_centre` (the other wheel pair on the
+//!   stepping side driven toward the centre until the STC's longitudinal coordinate meets
+//!   the CoM's, stopping before cells of infinite foot cost, height changes, and
+//!   [`MotionOptions::wheel_gap_m`] from the stepping foot), `base_shift` (only if a
+//!   longitudinal error of more than 2 cm remains: the wheel was blocked), `lift` (the
+//!   foot rises vertically to [`MotionOptions::swing_clearance_m`] above the highest
+//!   terrain within a wheel's reach of its straight path), `swing`, `place`, then
+//!   `shift_back`, `wheel_back`, `roll_back` (to the post-step pitch).
+//!
+//! **Stability** (Sec. VI-A): every keyframe and interpolated point (every 1 cm of base or
+//! foot motion and every 0.02 rad) is solved with the leg IK (reach with
+//! [`MotionOptions::reach_margin_m`] to spare, joint limits) and its CoM computed with the
+//! [`CenterOfMassModel`]; its margin in the support polygon of the feet in contact must be
+//! at least [`MotionOptions::min_margin_m`] (default 3 cm).
+//!
+//! **Alternatives before failing**: a step is tried with the manoeuvre leg height 0.45 m,
+//! then lower in 2.5 cm steps down to the driving height, then 0.50 and 0.55 m; for each, full wheel-to-centre alignment, half, none
+//! (a base shift takes what the wheel leaves: all of it, half, none), and full, half, then
+//! no roll. The first candidate
+//! whose every point holds is taken; otherwise [`MotionError::Step`] names the step, the leg
+//! and the best margin reached.
+
+use super::CenterOfMassModel;
+use super::keyframe::{DetailedPath, Keyframe, Phase};
+use super::kinematics::{Evaluation, Posture, contacts_in_base, evaluate, interpolate, rotation};
+use super::roll::roll_for_lateral_com;
+use crate::cost::CostMaps;
+use crate::geometry::{Pose2, wrap_angle};
+use crate::jobs::plan::{PathElement, PathKind};
+use crate::params::Params;
+use crate::robot::{Leg, RobotDescription};
+
+/// Constants of the expansion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionOptions {
+    /// Minimum static stability margin at every keyframe and interpolated point, m.
+    pub min_margin_m: f64,
+    /// Soft minimum leg height while standing (Sec. VI-B), m.
+    pub manoeuvre_leg_height_m: f64,
+    /// Driving leg height (Sec. VI-B), m.
+    pub driving_leg_height_m: f64,
+    /// Base pitch as a fraction of the ground slope (Sec. VI-B).
+    pub pitch_fraction: f64,
+    /// Spare reach every leg keeps (hip-to-ankle below thigh + shin by this much), m.
+    pub reach_margin_m: f64,
+    /// Swing foot clearance above the terrain near its path, m.
+    pub swing_clearance_m: f64,
+    /// Largest base roll, rad.
+    pub max_roll_rad: f64,
+    /// Largest stabilising base shift, m.
+    pub max_base_shift_m: f64,
+    /// Largest wheel-to-centre displacement, m.
+    pub max_wheel_to_centre_m: f64,
+    /// Smallest longitudinal gap between the displaced wheel pair and the stepping foot, m.
+    pub wheel_gap_m: f64,
+    /// Driving distance to the next manoeuvre from which the robot lowers in between, m.
+    pub stay_standing_m: f64,
+    /// Interpolation sample spacing, m.
+    pub sample_m: f64,
+    /// Interpolation sample spacing, rad.
+    pub sample_rad: f64,
+    /// Base and wheel speed for timing, m/s.
+    pub wheel_speed: f64,
+    /// Swing foot speed for timing, m/s.
+    pub foot_speed: f64,
+    /// Roll, pitch and yaw rate for timing, rad/s.
+    pub angular_speed: f64,
+}
+
+impl MotionOptions {
+    /// The paper's values from `params`, conservative speeds (0.1 m/s, 0.2 rad/s).
+    pub fn from_params(params: &Params) -> Self {
+        Self {
+            min_margin_m: params.min_stability_margin_m,
+            manoeuvre_leg_height_m: params.manoeuvre_leg_height_m,
+            driving_leg_height_m: params.driving_leg_height_m,
+            pitch_fraction: params.base_pitch_slope_fraction,
+            reach_margin_m: 0.002,
+            swing_clearance_m: 0.05,
+            max_roll_rad: 0.15,
+            max_base_shift_m: 0.2,
+            max_wheel_to_centre_m: 0.45,
+            wheel_gap_m: 0.3,
+            stay_standing_m: 1.0,
+            sample_m: 0.01,
+            sample_rad: 0.02,
+            wheel_speed: 0.1,
+            foot_speed: 0.1,
+            angular_speed: 0.2,
+        }
+    }
+}
+
+impl Default for MotionOptions {
+    fn default() -> Self {
+        Self::from_params(&Params::default())
+    }
+}
+
+/// Why a path cannot be expanded.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MotionError {
+    /// No candidate motion for a step keeps the robot stable and within reach.
+    #[error(
+        "path element {index}: step of leg {leg:?} has no stable motion (best margin {best_margin_m:.3} m, {required_m} m required): {reason}"
+    )]
+    Step {
+        /// Index of the step in the abstract path.
+        index: usize,
+        /// The stepping leg.
+        leg: Leg,
+        /// Best smallest margin over a candidate's points, m (−inf if none was feasible).
+        best_margin_m: f64,
+        /// The required margin, m.
+        required_m: f64,
+        /// Why the best candidate failed.
+        reason: String,
+    },
+    /// Another manoeuvre is infeasible or unstable.
+    #[error("path element {index} ({kind}): {reason}")]
+    Manoeuvre {
+        /// Index in the abstract path.
+        index: usize,
+        /// The manoeuvre.
+        kind: &'static str,
+        /// Why.
+        reason: String,
+    },
+    /// A foot stands on unknown terrain or off the map.
+    #[error("path element {index}: no terrain height at ({x:.3}, {y:.3})")]
+    UnknownTerrain {
+        /// Index in the abstract path.
+        index: usize,
+        /// World x, m.
+        x: f64,
+        /// World y, m.
+        y: f64,
+    },
+    /// The path is empty or does not start with its start pose.
+    #[error("the abstract path is empty")]
+    EmptyPath,
+}
+
+fn kind_name(k: PathKind) -> &'static str {
+    match k {
+        PathKind::Start => "start",
+        PathKind::Drive => "drive",
+        PathKind::Turn => "turn",
+        PathKind::Step => "step",
+        PathKind::BaseShift => "base_shift",
+        PathKind::FootForward => "foot_forward",
+        PathKind::FootNeutral => "foot_neutral",
+    }
+}
+
+/// A segment that passed: its end evaluation, smallest margins and sample count.
+struct SegmentCheck {
+    end: Evaluation,
+    min_margin: f64,
+    min_three: f64,
+    samples: usize,
+}
+
+struct Expander<'a> {
+    robot: &'a RobotDescription,
+    maps: &'a CostMaps,
+    model: &'a mut dyn CenterOfMassModel,
+    o: &'a MotionOptions,
+    keys: Vec<Keyframe>,
+    cur: Posture,
+    time: f64,
+    samples: usize,
+    min_margin: f64,
+    min_three: f64,
+    index: usize,
+}
+
+/// A planned keyframe before checking.
+type Planned = (Phase, Option<Leg>, Posture);
+
+impl Expander<'_> {
+    fn ground(&self, x: f64, y: f64) -> Result<f64, MotionError> {
+        self.maps.height_at(x, y).ok_or(MotionError::UnknownTerrain { index: self.index, x, y })
+    }
+
+    fn neutral_feet(&self, pose: &Pose2) -> Result<[[f64; 3]; 4], MotionError> {
+        let xy = self.maps.neutral_feet(pose);
+        let mut f = [[0.0; 3]; 4];
+        for i in 0..4 {
+            f[i] = [xy[i][0], xy[i][1], self.ground(xy[i][0], xy[i][1])?];
+        }
+        Ok(f)
+    }
+
+    /// Base pitch: `pitch_fraction` of the slope between the front and rear feet.
+    fn pitch_for(&self, feet: &[[f64; 3]; 4], yaw: f64) -> f64 {
+        let (s, c) = yaw.sin_cos();
+        let along = |f: [f64; 3]| c * f[0] + s * f[1];
+        let dx = (along(feet[0]) + along(feet[1]) - along(feet[2]) - along(feet[3])) / 2.0;
+        let dz = (feet[0][2] + feet[1][2] - feet[2][2] - feet[3][2]) / 2.0;
+        let slope = if dx.abs() > 1e-6 { (dz / dx).atan() } else { 0.0 };
+        -self.o.pitch_fraction * slope
+    }
+
+    /// Driving posture at `pose`: mean hip `driving_leg_height_m` above the mean ground.
+    fn driving(&self, pose: &Pose2) -> Result<Posture, MotionError> {
+        let feet = self.neutral_feet(pose)?;
+        let pitch = self.pitch_for(&feet, pose.theta);
+        let r = rotation([0.0, pitch, pose.theta]);
+        let z = (0..4)
+            .map(|i| {
+                let h = self.robot.hips[i];
+                let dz = r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2];
+                feet[i][2] + self.o.driving_leg_height_m - dz
+            })
+            .sum::<f64>()
+            / 4.0;
+        Ok(Posture {
+            base_position: [pose.x, pose.y, z],
+            base_rpy: [0.0, pitch, pose.theta],
+            feet,
+            contact: [true; 4],
+        })
+    }
+
+    /// Standing posture: base height from the highest relevant ground (`ground`, per leg)
+    /// so the shortest leg is `height`; base moved laterally so the feet in contact lie on
+    /// their legs' planes on average; feet not in contact put on their leg planes.
+    #[allow(clippy::too_many_arguments)]
+    fn standing(
+        &self,
+        feet: [[f64; 3]; 4],
+        contact: [bool; 4],
+        xy: [f64; 2],
+        yaw: f64,
+        pitch: f64,
+        roll: f64,
+        height: f64,
+        ground: [f64; 4],
+    ) -> Posture {
+        let rpy = [roll, pitch, yaw];
+        let r = rotation(rpy);
+        let mut p = Posture { base_position: [xy[0], xy[1], 0.0], base_rpy: rpy, feet, contact };
+        for _ in 0..3 {
+            let z = (0..4)
+                .map(|i| {
+                    let h = self.robot.hips[i];
+                    let dz = r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2];
+                    ground[i] + height - dz
+                })
+                .fold(f64::NEG_INFINITY, f64::max);
+            p.base_position[2] = z;
+            let local = contacts_in_base(self.robot, &p);
+            let n = contact.iter().filter(|&&c| c).count().max(1) as f64;
+            let m = (0..4).filter(|&i| contact[i]).map(|i| local[i][1]).sum::<f64>() / n;
+            for (b, row) in p.base_position.iter_mut().zip(&r) {
+                *b += row[1] * m;
+            }
+        }
+        let local = contacts_in_base(self.robot, &p);
+        for i in 0..4 {
+            if !contact[i] {
+                let h = self.robot.hips[i];
+                let b = [local[i][0] + h[0], h[1], local[i][2] + h[2]];
+                p.feet[i] = super::kinematics::apply(&r, p.base_position, b);
+            }
+        }
+        p
+    }
+
+    /// A standing posture for all four feet in contact, lowering the leg height from the
+    /// manoeuvre height in 1 cm steps until every leg reaches (Sec. VI-B soft constraint).
+    fn standing_fallback(
+        &mut self,
+        feet: [[f64; 3]; 4],
+        xy: [f64; 2],
+        yaw: f64,
+    ) -> Result<Posture, String> {
+        let pitch = self.pitch_for(&feet, yaw);
+        let ground = feet.map(|f| f[2]);
+        let mut h = self.o.manoeuvre_leg_height_m;
+        let mut last = String::new();
+        while h >= self.o.driving_leg_height_m - 1e-9 {
+            let p = self.standing(feet, [true; 4], xy, yaw, pitch, 0.0, h, ground);
+            match evaluate(self.robot, self.model, &p, self.o.reach_margin_m) {
+                Ok(_) => return Ok(p),
+                Err(e) => last = e.to_string(),
+            }
+            h -= 0.01;
+        }
+        Err(format!("no standing leg height reaches every foot: {last}"))
+    }
+
+    fn com_of(&mut self, p: &Posture) -> Result<[f64; 3], String> {
+        evaluate(self.robot, self.model, p, self.o.reach_margin_m)
+            .map(|e| e.com)
+            .map_err(|e| e.to_string())
+    }
+
+    /// Checks the segment from `a` to `b` (interpolated points and `b`); `drive` keeps the
+    /// feet in the neutral footprint under the moving base.
+    fn check_segment(
+        &mut self,
+        a: &Posture,
+        b: &Posture,
+        drive: bool,
+    ) -> Result<SegmentCheck, String> {
+        let o = self.o;
+        let dist = |p: [f64; 3], q: [f64; 3]| {
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+        };
+        let lin = (0..4)
+            .map(|i| dist(a.feet[i], b.feet[i]))
+            .fold(dist(a.base_position, b.base_position), f64::max);
+        let ang =
+            (0..3).map(|k| wrap_angle(b.base_rpy[k] - a.base_rpy[k]).abs()).fold(0.0, f64::max);
+        let n = ((lin / o.sample_m).ceil().max((ang / o.sample_rad).ceil()) as usize).max(1);
+        let mut min_margin = f64::INFINITY;
+        let mut min_three = f64::INFINITY;
+        let mut end = None;
+        for j in 1..=n {
+            let t = j as f64 / n as f64;
+            let mut p = if j == n { *b } else { interpolate(a, b, t) };
+            if drive && j < n {
+                let pose =
+                    Pose2 { x: p.base_position[0], y: p.base_position[1], theta: p.base_rpy[2] };
+                let xy = self.maps.neutral_feet(&pose);
+                for (f, w) in p.feet.iter_mut().zip(xy) {
+                    let z = self.maps.height_at(w[0], w[1]).unwrap_or(f[2]);
+                    *f = [w[0], w[1], z];
+                }
+            }
+            let e = evaluate(self.robot, self.model, &p, o.reach_margin_m)
+                .map_err(|e| format!("at {:.0} % of the segment: {e}", t * 100.0))?;
+            if e.margin < o.min_margin_m {
+                return Err(format!(
+                    "stability margin {:.3} m at {:.0} % of the segment (CoM {:.3}, {:.3})",
+                    e.margin,
+                    t * 100.0,
+                    e.com[0],
+                    e.com[1]
+                ));
+            }
+            min_margin = min_margin.min(e.margin);
+            if p.contact.iter().filter(|&&c| c).count() == 3 {
+                min_three = min_three.min(e.margin);
+            }
+            end = Some(e);
+        }
+        let end = end.ok_or_else(|| "empty segment".to_owned())?;
+        Ok(SegmentCheck { end, min_margin, min_three, samples: n })
+    }
+
+    fn duration(&self, a: &Posture, b: &Posture) -> f64 {
+        let o = self.o;
+        let d2 = |p: [f64; 3], q: [f64; 3]| (p[0] - q[0]).hypot(p[1] - q[1]).hypot(p[2] - q[2]);
+        let base = d2(a.base_position, b.base_position) / o.wheel_speed;
+        let feet = (0..4).map(|i| d2(a.feet[i], b.feet[i])).fold(0.0, f64::max) / o.foot_speed;
+        let ang =
+            (0..3).map(|k| wrap_angle(b.base_rpy[k] - a.base_rpy[k]).abs()).fold(0.0, f64::max)
+                / o.angular_speed;
+        base.max(feet).max(ang).max(0.1)
+    }
+
+    /// Checks a sequence from the current posture without committing it; returns the
+    /// keyframes and the sequence's smallest margin.
+    fn trial(&mut self, seq: &[Planned]) -> Result<(Vec<Keyframe>, f64, f64, usize), String> {
+        let mut from = self.cur;
+        let mut t = self.time;
+        let mut out = Vec::with_capacity(seq.len());
+        let (mut mm, mut m3, mut samples) = (f64::INFINITY, f64::INFINITY, 0);
+        for &(phase, leg, p) in seq {
+            let c = self
+                .check_segment(&from, &p, phase == Phase::Drive)
+                .map_err(|e| format!("{}: {e}", phase.name()))?;
+            t += self.duration(&from, &p);
+            mm = mm.min(c.min_margin);
+            m3 = m3.min(c.min_three);
+            samples += c.samples;
+            out.push(Keyframe {
+                time_s: t,
+                phase,
+                path_index: self.index,
+                leg,
+                base_position: p.base_position,
+                base_rpy: p.base_rpy,
+                feet: p.feet,
+                contact: p.contact,
+                leg_heights: c.end.leg_heights,
+                joints: c.end.joints,
+                com: c.end.com,
+                margin_m: c.end.margin,
+                segment_min_margin_m: c.min_margin,
+                centroid_distance_m: c.end.centroid_distance,
+            });
+            from = p;
+        }
+        Ok((out, mm, m3, samples))
+    }
+
+    fn commit(&mut self, keys: Vec<Keyframe>, mm: f64, m3: f64, samples: usize) {
+        if let Some(k) = keys.last() {
+            self.cur = k.posture();
+            self.time = k.time_s;
+        }
+        self.min_margin = self.min_margin.min(mm);
+        self.min_three = self.min_three.min(m3);
+        self.samples += samples;
+        self.keys.extend(keys);
+    }
+
+    fn push(&mut self, kind: PathKind, seq: &[Planned]) -> Result<(), MotionError> {
+        let (k, mm, m3, s) = self.trial(seq).map_err(|reason| MotionError::Manoeuvre {
+            index: self.index,
+            kind: kind_name(kind),
+            reason,
+        })?;
+        self.commit(k, mm, m3, s);
+        Ok(())
+    }
+
+    fn stand_up(&mut self, kind: PathKind) -> Result<(), MotionError> {
+        let (feet, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
+        let p = self.standing_fallback(feet, xy, yaw).map_err(|reason| MotionError::Manoeuvre {
+            index: self.index,
+            kind: kind_name(kind),
+            reason,
+        })?;
+        self.push(kind, &[(Phase::StandUp, None, p)])
+    }
+
+    fn xy(&self) -> [f64; 2] {
+        [self.cur.base_position[0], self.cur.base_position[1]]
+    }
+
+    /// Highest terrain within `radius` of the segment `a`–`b`, m.
+    fn max_height_near(&self, a: [f64; 3], b: [f64; 3], radius: f64) -> f64 {
+        let res = self.maps.heights().resolution();
+        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let n = (len / (res / 2.0)).ceil().max(1.0) as usize;
+        let r = (radius / res).ceil() as i64;
+        let mut best = a[2].max(b[2]);
+        for s in 0..=n {
+            let t = s as f64 / n as f64;
+            let (x, y) = (a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t);
+            for dj in -r..=r {
+                for di in -r..=r {
+                    let (dx, dy) = (di as f64 * res, dj as f64 * res);
+                    if dx.hypot(dy) <= radius + 1e-9
+                        && let Some(h) = self.maps.height_at(x + dx, y + dy)
+                    {
+                        best = best.max(h);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Builds the keyframes of one step candidate.
+    fn step_candidate(
+        &mut self,
+        leg: Leg,
+        post_foot: [f64; 3],
+        height: f64,
+        wheel_fraction: f64,
+        roll_fraction: f64,
+        shift_fraction: f64,
+    ) -> Result<Vec<Planned>, String> {
+        let o = self.o.clone();
+        let i = leg.index();
+        let j = leg.same_side_partner().index();
+        let yaw = self.cur.base_rpy[2];
+        let (s, c) = yaw.sin_cos();
+        let along = |f: [f64; 3]| c * f[0] + s * f[1];
+        let lateral = |f: [f64; 3]| -s * f[0] + c * f[1];
+        let pre = self.cur.feet;
+        let mut post = pre;
+        post[i] = post_foot;
+        let pitch = (self.pitch_for(&pre, yaw) + self.pitch_for(&post, yaw)) / 2.0;
+        let pitch_post = self.pitch_for(&post, yaw);
+        let mut ground = pre.map(|f| f[2]);
+        ground[i] = pre[i][2].max(post_foot[2]);
+        let xy = self.xy();
+        let all = [true; 4];
+        let mut lifted = all;
+        lifted[i] = false;
+
+        // Longitudinal alignment: the partner wheel toward the centre (Fig. 12a).
+        let p0 = self.standing(pre, all, xy, yaw, pitch, 0.0, height, ground);
+        let c0 = self.com_of(&p0)?;
+        let others: Vec<usize> = (0..4).filter(|&k| k != i && k != j).collect();
+        let x_des = 3.0 * along(c0) - others.iter().map(|&k| along(pre[k])).sum::<f64>();
+        let sign = if Leg::ALL[j].is_front() { -1.0 } else { 1.0 };
+        let wanted = ((x_des - along(pre[j])) * sign).clamp(0.0, o.max_wheel_to_centre_m);
+        let gap_limit = if sign > 0.0 {
+            along(pre[i]).min(along(post_foot)) - o.wheel_gap_m - along(pre[j])
+        } else {
+            along(pre[j]) - (along(pre[i]).max(along(post_foot)) + o.wheel_gap_m)
+        };
+        let target = (wanted * wheel_fraction).min(gap_limit.max(0.0));
+        let mut d = 0.0;
+        let step = 0.01;
+        while d + step <= target + 1e-9 {
+            let e = d + step;
+            let (x, y) = (pre[j][0] + sign * e * c, pre[j][1] + sign * e * s);
+            let ok = self.maps.foot_cost_at(x, y).is_finite()
+                && self.maps.height_at(x, y).is_some_and(|h| (h - pre[j][2]).abs() < 0.02);
+            if !ok {
+                break;
+            }
+            d = e;
+        }
+        let mut moved = pre;
+        if d > 0.0 {
+            let (x, y) = (pre[j][0] + sign * d * c, pre[j][1] + sign * d * s);
+            moved[j] = [x, y, self.maps.height_at(x, y).unwrap_or(pre[j][2])];
+        }
+
+        // Lateral alignment: roll (eqs. 6–8), iterated with the CoM model.
+        let support: Vec<[f64; 3]> = (0..4).filter(|&k| k != i).map(|k| moved[k]).collect();
+        let stc = [
+            support.iter().map(|f| f[0]).sum::<f64>() / 3.0,
+            support.iter().map(|f| f[1]).sum::<f64>() / 3.0,
+            0.0,
+        ];
+        let y_rot = moved.iter().map(|&f| lateral(f)).sum::<f64>() / 4.0;
+        let z_rot = support.iter().map(|f| f[2]).sum::<f64>() / 3.0;
+        let left = (lateral(moved[0]) + lateral(moved[2])) / 2.0;
+        let right = (lateral(moved[1]) + lateral(moved[3])) / 2.0;
+        let b = (left - right).abs();
+        let p1 = self.standing(moved, all, xy, yaw, pitch, 0.0, height, ground);
+        let mut com = self.com_of(&p1)?;
+        let y_target = lateral(com) + roll_fraction * (lateral(stc) - lateral(com));
+        let mut roll = 0.0;
+        for _ in 0..5 {
+            if (lateral(com) - y_target).abs() < 0.003 {
+                break;
+            }
+            let sol = roll_for_lateral_com([y_rot, z_rot], [lateral(com), com[2]], y_target, b)
+                .map_err(|e| e.to_string())?;
+            roll = (roll + sol.roll).clamp(-o.max_roll_rad, o.max_roll_rad);
+            let p = self.standing(moved, all, xy, yaw, pitch, roll, height, ground);
+            com = self.com_of(&p)?;
+        }
+
+        // Longitudinal remainder: base shift (Fig. 12b).
+        // Only when the wheel could not go as far as alignment wanted (blocked, or a
+        // candidate with a shorter wheel move).
+        let hindered = d + 1e-3 < wanted;
+        let shift = {
+            let rem = along(stc) - along(com);
+            if hindered && rem.abs() > 0.02 {
+                shift_fraction * rem.clamp(-o.max_base_shift_m, o.max_base_shift_m)
+            } else {
+                0.0
+            }
+        };
+        let xy_shift = [xy[0] + shift * c, xy[1] + shift * s];
+
+        // Swing height.
+        let radius = self.robot.wheel_radius + self.robot.wheel_track / 2.0 + 0.02;
+        let swing_z = self.max_height_near(pre[i], post_foot, radius) + o.swing_clearance_m;
+        let mut lift_feet = moved;
+        lift_feet[i] = [pre[i][0], pre[i][1], swing_z];
+        let mut swing_feet = moved;
+        swing_feet[i] = [post_foot[0], post_foot[1], swing_z];
+        let mut placed = moved;
+        placed[i] = post_foot;
+
+        let st = |feet, contact, xy, roll, pitch| {
+            self.standing(feet, contact, xy, yaw, pitch, roll, height, ground)
+        };
+        let mut seq: Vec<Planned> = Vec::new();
+        seq.push((Phase::Roll, None, st(pre, all, xy, roll, pitch)));
+        if d > 0.0 {
+            seq.push((Phase::WheelToCentre, Some(Leg::ALL[j]), st(moved, all, xy, roll, pitch)));
+        }
+        if shift != 0.0 {
+            seq.push((Phase::BaseShift, None, st(moved, all, xy_shift, roll, pitch)));
+        }
+        seq.push((Phase::Lift, Some(leg), st(lift_feet, lifted, xy_shift, roll, pitch)));
+        seq.push((Phase::Swing, Some(leg), st(swing_feet, lifted, xy_shift, roll, pitch)));
+        seq.push((Phase::Place, Some(leg), st(placed, all, xy_shift, roll, pitch)));
+        if shift != 0.0 {
+            seq.push((Phase::ShiftBack, None, st(placed, all, xy, roll, pitch)));
+        }
+        let mut back = placed;
+        back[j] = pre[j];
+        if d > 0.0 {
+            seq.push((Phase::WheelBack, Some(Leg::ALL[j]), st(back, all, xy, roll, pitch)));
+        }
+        let mut post_ground = back.map(|f| f[2]);
+        post_ground[i] = ground[i];
+        seq.push((
+            Phase::RollBack,
+            None,
+            self.standing(back, all, xy, yaw, pitch_post, 0.0, height, post_ground),
+        ));
+        Ok(seq)
+    }
+
+    fn expand_step(&mut self, leg: Leg, post_xy: [f64; 2]) -> Result<(), MotionError> {
+        let post_foot = [post_xy[0], post_xy[1], self.ground(post_xy[0], post_xy[1])?];
+        let base_h = self.o.manoeuvre_leg_height_m;
+        let mut heights = vec![base_h];
+        let mut h = base_h - 0.025;
+        while h >= self.o.driving_leg_height_m - 1e-9 {
+            heights.push(h);
+            h -= 0.025;
+        }
+        heights.extend([base_h + 0.05, base_h + 0.1]);
+        let mut best: (f64, String) = (f64::NEG_INFINITY, "no candidate".to_owned());
+        for &h in &heights {
+            for &wf in &[1.0, 0.5, 0.0] {
+                for (rf, shift) in [
+                    (1.0, 1.0),
+                    (1.0, 0.5),
+                    (1.0, 0.0),
+                    (0.5, 1.0),
+                    (0.5, 0.5),
+                    (0.5, 0.0),
+                    (0.0, 1.0),
+                    (0.0, 0.5),
+                    (0.0, 0.0),
+                ] {
+                    let seq = match self.step_candidate(leg, post_foot, h, wf, rf, shift) {
+                        Ok(s) => s,
+                        Err(e) => {
+                            if best.0 == f64::NEG_INFINITY {
+                                best.1 = e;
+                            }
+                            continue;
+                        }
+                    };
+                    match self.trial(&seq) {
+                        Ok((k, mm, m3, s)) => {
+                            self.commit(k, mm, m3, s);
+                            return Ok(());
+                        }
+                        Err(e) => {
+                            let m = margin_in(&e);
+                            if m > best.0 || best.0 == f64::NEG_INFINITY {
+                                best = (m, e);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Err(MotionError::Step {
+            index: self.index,
+            leg,
+            best_margin_m: best.0,
+            required_m: self.o.min_margin_m,
+            reason: best.1,
+        })
+    }
+}
+
+/// The margin quoted in a failure message, −inf if none.
+fn margin_in(msg: &str) -> f64 {
+    msg.split("stability margin ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse::<f64>().ok())
+        .unwrap_or(f64::NEG_INFINITY)
+}
+
+/// Expands an abstract path (`jobs::plan::PlanSummary::path`) into a detailed path of
+/// stable keyframes (see the module docs).
+///
+/// # Errors
+/// [`MotionError`] naming the path element (and for steps the leg and best margin) when no
+/// stable, reachable motion is found, or a foot stands on unknown terrain.
+pub fn expand_path(
+    path: &[PathElement],
+    robot: &RobotDescription,
+    maps: &CostMaps,
+    model: &mut dyn CenterOfMassModel,
+    options: &MotionOptions,
+) -> Result<DetailedPath, MotionError> {
+    let first = path.first().ok_or(MotionError::EmptyPath)?;
+    let mut ex = Expander {
+        robot,
+        maps,
+        model,
+        o: options,
+        keys: Vec::new(),
+        cur: Posture {
+            base_position: [first.pose.x, first.pose.y, 0.0],
+            base_rpy: [0.0, 0.0, first.pose.theta],
+            feet: [[0.0; 3]; 4],
+            contact: [true; 4],
+        },
+        time: 0.0,
+        samples: 0,
+        min_margin: f64::INFINITY,
+        min_three: f64::INFINITY,
+        index: 0,
+    };
+    let start = ex.driving(&first.pose)?;
+    ex.cur = start;
+    let e = evaluate(robot, ex.model, &start, options.reach_margin_m)
+        .map_err(|e| MotionError::Manoeuvre { index: 0, kind: "start", reason: e.to_string() })?;
+    ex.min_margin = e.margin;
+    ex.samples = 1;
+    ex.keys.push(Keyframe {
+        time_s: 0.0,
+        phase: Phase::Start,
+        path_index: 0,
+        leg: None,
+        base_position: start.base_position,
+        base_rpy: start.base_rpy,
+        feet: start.feet,
+        contact: start.contact,
+        leg_heights: e.leg_heights,
+        joints: e.joints,
+        com: e.com,
+        margin_m: e.margin,
+        segment_min_margin_m: e.margin,
+        centroid_distance_m: e.centroid_distance,
+    });
+    let special = |k: PathKind| !matches!(k, PathKind::Start | PathKind::Drive | PathKind::Turn);
+    let mut standing = false;
+    let mut steps = 0;
+    for (k, el) in path.iter().enumerate().skip(1) {
+        ex.index = k;
+        match el.kind {
+            PathKind::Start => {}
+            PathKind::Drive | PathKind::Turn => {
+                if standing {
+                    // Lower if the next manoeuvre is far (or there is none).
+                    let mut dist = 0.0;
+                    let mut prev = path[k - 1].pose;
+                    let mut next_special = false;
+                    for e2 in &path[k..] {
+                        if special(e2.kind) {
+                            next_special = true;
+                            break;
+                        }
+                        dist += prev.distance(&e2.pose);
+                        prev = e2.pose;
+                    }
+                    if !next_special || dist >= options.stay_standing_m {
+                        let pose = Pose2 {
+                            x: ex.cur.base_position[0],
+                            y: ex.cur.base_position[1],
+                            theta: ex.cur.base_rpy[2],
+                        };
+                        let p = ex.driving(&pose)?;
+                        ex.push(el.kind, &[(Phase::Lower, None, p)])?;
+                        standing = false;
+                    }
+                }
+                let target = if standing {
+                    let feet = ex.neutral_feet(&el.pose)?;
+                    ex.standing_fallback(feet, [el.pose.x, el.pose.y], el.pose.theta).map_err(
+                        |reason| MotionError::Manoeuvre {
+                            index: k,
+                            kind: kind_name(el.kind),
+                            reason,
+                        },
+                    )?
+                } else {
+                    ex.driving(&el.pose)?
+                };
+                ex.push(el.kind, &[(Phase::Drive, None, target)])?;
+            }
+            PathKind::Step
+            | PathKind::BaseShift
+            | PathKind::FootForward
+            | PathKind::FootNeutral => {
+                if !standing {
+                    ex.stand_up(el.kind)?;
+                    standing = true;
+                }
+                let bad = |reason: String| MotionError::Manoeuvre {
+                    index: k,
+                    kind: kind_name(el.kind),
+                    reason,
+                };
+                match (el.kind, el.leg) {
+                    (PathKind::Step, Some(leg)) => {
+                        ex.expand_step(leg, el.feet[leg.index()])?;
+                        steps += 1;
+                    }
+                    (PathKind::BaseShift, _) => {
+                        let feet = ex.cur.feet;
+                        let p = ex
+                            .standing_fallback(feet, [el.pose.x, el.pose.y], el.pose.theta)
+                            .map_err(bad)?;
+                        ex.push(el.kind, &[(Phase::PlannedBaseShift, None, p)])?;
+                    }
+                    (_, Some(leg)) => {
+                        let mut feet = ex.cur.feet;
+                        let f = el.feet[leg.index()];
+                        feet[leg.index()] = [f[0], f[1], ex.ground(f[0], f[1])?];
+                        let (xy, yaw) = (ex.xy(), ex.cur.base_rpy[2]);
+                        let p = ex.standing_fallback(feet, xy, yaw).map_err(bad)?;
+                        ex.push(el.kind, &[(Phase::WheelMove, Some(leg), p)])?;
+                    }
+                    (_, None) => return Err(bad("no leg named".to_owned())),
+                }
+            }
+        }
+    }
+    if standing {
+        ex.index = path.len() - 1;
+        let pose = Pose2 {
+            x: ex.cur.base_position[0],
+            y: ex.cur.base_position[1],
+            theta: ex.cur.base_rpy[2],
+        };
+        let p = ex.driving(&pose)?;
+        ex.push(PathKind::Drive, &[(Phase::Lower, None, p)])?;
+    }
+    let min_keyframe = ex.keys.iter().map(|k| k.margin_m).fold(f64::INFINITY, f64::min);
+    Ok(DetailedPath {
+        duration_s: ex.time,
+        min_keyframe_margin_m: min_keyframe,
+        min_margin_m: ex.min_margin,
+        min_three_contact_margin_m: ex.min_three,
+        samples_checked: ex.samples,
+        steps,
+        keyframes: ex.keys,
+    })
+}

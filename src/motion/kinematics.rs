@@ -1,0 +1,210 @@
+//! A whole-robot posture and what it implies: per-leg IK, leg heights, CoM and static
+//! stability (Sec. VI-A).
+//!
+//! A [`Posture`] is the base pose (position, roll/pitch/yaw) and the four wheel contact
+//! points in the world. Each leg's contact point is expressed in the base frame and solved
+//! with the sagittal leg IK (`robot::ik::leg_ik`, wheel level for the base pitch). A rolled
+//! base tilts the legs' sagittal planes; the contact's lateral offset from the hip plane
+//! (a few millimetres for the rolls used) is taken up by the compliant legs and foam wheels
+//! (Sec. VI-A) and is bounded by [`MAX_LATERAL_MISMATCH_M`] for feet in contact.
+
+use super::CenterOfMassModel;
+use crate::robot::ik::{IkError, leg_ik};
+use crate::robot::{Leg, RobotDescription};
+use crate::stability::{convex_hull, stability_margin};
+use serde::Serialize;
+
+/// Largest lateral offset of a contact point from its hip's sagittal plane accepted for a
+/// foot in contact, m.
+pub const MAX_LATERAL_MISMATCH_M: f64 = 0.03;
+
+/// Rotation matrix of roll, pitch, yaw (ZYX: R = Rz(yaw)·Ry(pitch)·Rx(roll)), row-major.
+pub fn rotation(rpy: [f64; 3]) -> [[f64; 3]; 3] {
+    let (sr, cr) = rpy[0].sin_cos();
+    let (sp, cp) = rpy[1].sin_cos();
+    let (sy, cy) = rpy[2].sin_cos();
+    [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ]
+}
+
+/// `position + r · p`.
+pub(crate) fn apply(r: &[[f64; 3]; 3], position: [f64; 3], p: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| position[i] + r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2])
+}
+
+/// `rᵀ · (w − position)`.
+pub(crate) fn apply_inverse(r: &[[f64; 3]; 3], position: [f64; 3], w: [f64; 3]) -> [f64; 3] {
+    let d = [w[0] - position[0], w[1] - position[1], w[2] - position[2]];
+    std::array::from_fn(|i| r[0][i] * d[0] + r[1][i] * d[1] + r[2][i] * d[2])
+}
+
+/// Base pose, foot positions and contacts of the whole robot.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Posture {
+    /// Base origin in the world, m.
+    pub base_position: [f64; 3],
+    /// Base roll, pitch, yaw (ZYX; pitch positive nose down, roll positive left side up), rad.
+    pub base_rpy: [f64; 3],
+    /// Wheel contact points in the world, FL, FR, RL, RR, m.
+    pub feet: [[f64; 3]; 4],
+    /// Which feet bear weight.
+    pub contact: [bool; 4],
+}
+
+/// Why a posture is not feasible.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PostureError {
+    /// Leg IK failed (reach or joint limits).
+    #[error(transparent)]
+    Ik(#[from] IkError),
+    /// A leg would be straighter than the reach margin allows.
+    #[error("leg {leg:?}: hip-to-ankle {distance:.3} m leaves less than {margin} m of reach")]
+    ReachMargin {
+        /// The leg.
+        leg: Leg,
+        /// Hip-to-ankle distance, m.
+        distance: f64,
+        /// Required spare reach, m.
+        margin: f64,
+    },
+    /// A foot in contact lies too far from its leg's sagittal plane.
+    #[error("leg {leg:?}: contact {offset:.3} m off the leg plane")]
+    Lateral {
+        /// The leg.
+        leg: Leg,
+        /// Lateral offset, m.
+        offset: f64,
+    },
+}
+
+/// What a feasible posture implies.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Evaluation {
+    /// Joint targets (hip, knee, ankle) per leg, rad.
+    pub joints: [[f64; 3]; 4],
+    /// Leg heights: hip axis above the foot's contact point, world vertical, m.
+    pub leg_heights: [f64; 4],
+    /// CoM (world), m.
+    pub com: [f64; 3],
+    /// Signed distance of the horizontal CoM projection to the support polygon's edge, m.
+    pub margin: f64,
+    /// Horizontal distance of the CoM projection to the support polygon's centroid (the
+    /// support triangle centroid, STC, with three contacts), m.
+    pub centroid_distance: f64,
+}
+
+/// Vertex mean of the convex hull of `points` (the triangle centroid for three points).
+pub fn support_centroid(points: &[[f64; 2]]) -> Option<[f64; 2]> {
+    let hull = convex_hull(points);
+    if hull.is_empty() {
+        return None;
+    }
+    let n = hull.len() as f64;
+    Some([hull.iter().map(|p| p[0]).sum::<f64>() / n, hull.iter().map(|p| p[1]).sum::<f64>() / n])
+}
+
+/// Per leg: the contact point (x', y', z') relative to the hip in the base frame.
+pub fn contacts_in_base(robot: &RobotDescription, p: &Posture) -> [[f64; 3]; 4] {
+    let r = rotation(p.base_rpy);
+    std::array::from_fn(|i| {
+        let b = apply_inverse(&r, p.base_position, p.feet[i]);
+        let h = robot.hips[i];
+        [b[0] - h[0], b[1] - h[1], b[2] - h[2]]
+    })
+}
+
+/// World position of each hip axis.
+pub fn hips_in_world(robot: &RobotDescription, p: &Posture) -> [[f64; 3]; 4] {
+    let r = rotation(p.base_rpy);
+    std::array::from_fn(|i| apply(&r, p.base_position, robot.hips[i]))
+}
+
+/// Solves the legs of `p`, computes the CoM with `model` and the stability margin of the
+/// feet in contact.
+///
+/// # Errors
+/// [`PostureError`] if a leg cannot reach its foot with `reach_margin` m to spare, a joint
+/// limit is passed, or a foot in contact lies off its leg plane.
+pub fn evaluate(
+    robot: &RobotDescription,
+    model: &mut dyn CenterOfMassModel,
+    p: &Posture,
+    reach_margin: f64,
+) -> Result<Evaluation, PostureError> {
+    let local = contacts_in_base(robot, p);
+    let hips = hips_in_world(robot, p);
+    let pitch = p.base_rpy[1];
+    let below = robot.foot_length + robot.wheel_radius;
+    let reach = robot.thigh_length + robot.shin_length;
+    let mut joints = [[0.0; 3]; 4];
+    for leg in Leg::ALL {
+        let i = leg.index();
+        let c = local[i];
+        if p.contact[i] && c[1].abs() > MAX_LATERAL_MISMATCH_M {
+            return Err(PostureError::Lateral { leg, offset: c[1] });
+        }
+        // Ankle position as leg_ik computes it: the foot segment along world down.
+        let ankle = [c[0] + below * (-pitch).sin(), c[2] + below * (-pitch).cos()];
+        let distance = ankle[0].hypot(ankle[1]);
+        if distance > reach - reach_margin {
+            return Err(PostureError::ReachMargin { leg, distance, margin: reach_margin });
+        }
+        joints[i] = leg_ik(robot, leg, [c[0], c[2]], pitch)?;
+    }
+    let leg_heights = std::array::from_fn(|i| hips[i][2] - p.feet[i][2]);
+    let com = model.com(p.base_position, p.base_rpy, &joints);
+    let support: Vec<[f64; 2]> =
+        (0..4).filter(|&i| p.contact[i]).map(|i| [p.feet[i][0], p.feet[i][1]]).collect();
+    let margin = stability_margin(&support, [com[0], com[1]]);
+    let centroid_distance =
+        support_centroid(&support).map_or(f64::INFINITY, |c| (c[0] - com[0]).hypot(c[1] - com[1]));
+    Ok(Evaluation { joints, leg_heights, com, margin, centroid_distance })
+}
+
+/// Linear interpolation of two postures at `t` ∈ [0, 1] (base pose and feet; yaw along the
+/// shorter way). Contacts: a foot bears weight only if it does at both ends.
+pub fn interpolate(a: &Posture, b: &Posture, t: f64) -> Posture {
+    let lerp = |x: f64, y: f64| x + (y - x) * t;
+    let dyaw = crate::geometry::wrap_angle(b.base_rpy[2] - a.base_rpy[2]);
+    Posture {
+        base_position: std::array::from_fn(|k| lerp(a.base_position[k], b.base_position[k])),
+        base_rpy: [
+            lerp(a.base_rpy[0], b.base_rpy[0]),
+            lerp(a.base_rpy[1], b.base_rpy[1]),
+            a.base_rpy[2] + dyaw * t,
+        ],
+        feet: std::array::from_fn(|i| std::array::from_fn(|k| lerp(a.feet[i][k], b.feet[i][k]))),
+        contact: std::array::from_fn(|i| a.contact[i] && b.contact[i]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_matches_zyx_convention() {
+        // Pitch +0.3 (nose down): the base x axis points down.
+        let r = rotation([0.0, 0.3, 0.0]);
+        assert!((r[2][0] + 0.3f64.sin()).abs() < 1e-12);
+        // Roll +0.2: the base y axis (left) points up.
+        let r = rotation([0.2, 0.0, 0.0]);
+        assert!((r[2][1] - 0.2f64.sin()).abs() < 1e-12);
+        let r = rotation([0.1, -0.2, 0.7]);
+        let p = [0.3, -0.1, 0.4];
+        let w = apply(&r, [1.0, 2.0, 3.0], p);
+        let back = apply_inverse(&r, [1.0, 2.0, 3.0], w);
+        for k in 0..3 {
+            assert!((back[k] - p[k]).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn triangle_centroid() {
+        let c = support_centroid(&[[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]]).unwrap();
+        assert!((c[0] - 1.0).abs() < 1e-12 && (c[1] - 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,102 @@
+//! Step motion generation (Klamt & Behnke 2017, Sec. VI): the abstract path of the hybrid
+//! planner expanded into a timed sequence of statically stable, kinematically feasible
+//! keyframes — the contract the step executor consumes.
+//!
+//! - [`roll`]: the base roll of eqs. 6–8 (lateral CoM alignment), a pure function.
+//! - [`kinematics`]: a whole-robot posture (base pose, feet, contacts) → leg IK, leg
+//!   heights, CoM (through [`CenterOfMassModel`]) and the static stability margin.
+//! - [`keyframe`]: [`Keyframe`], [`Phase`], [`DetailedPath`] (serialisable).
+//! - [`expand`]: [`expand_path`], the expansion itself (see its docs for every manoeuvre).
+//!
+//! The module does not import MuJoCo: the CoM comes from a [`CenterOfMassModel`], which
+//! `sim::Simulation` implements with MuJoCo's own kinematics (so planner and simulator
+//! agree by construction) and [`LumpedMassModel`] implements analytically for unit tests.
+
+pub mod expand;
+pub mod keyframe;
+pub mod kinematics;
+pub mod roll;
+
+pub use expand::{MotionError, MotionOptions, expand_path};
+pub use keyframe::{DetailedPath, Keyframe, Phase};
+pub use kinematics::{Evaluation, Posture, rotation};
+pub use roll::{RollError, RollSolution, roll_for_lateral_com};
+
+use crate::robot::RobotDescription;
+use crate::robot::ik::leg_fk;
+
+/// The whole robot's centre of mass (world frame, m) for a commanded configuration: base
+/// position, base roll/pitch/yaw (ZYX, MuJoCo's signs) and per-leg (hip, knee, ankle)
+/// joint angles, FL, FR, RL, RR.
+pub trait CenterOfMassModel {
+    /// The CoM of the configuration.
+    fn com(
+        &mut self,
+        base_position: [f64; 3],
+        base_rpy: [f64; 3],
+        legs: &[[f64; 3]; 4],
+    ) -> [f64; 3];
+}
+
+/// An analytic CoM model for tests and quick estimates: a body point mass fixed in the base
+/// frame plus, per leg, a point mass at the middle of the thigh–shin chain and one at the
+/// wheel axle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LumpedMassModel {
+    /// The robot's kinematics.
+    pub robot: RobotDescription,
+    /// Body (base, torso, head) mass, kg.
+    pub body_mass: f64,
+    /// Body CoM in the base frame, m.
+    pub body_com: [f64; 3],
+    /// Mass per leg at the knee, kg.
+    pub knee_mass: f64,
+    /// Mass per leg at the wheel axle, kg.
+    pub wheel_mass: f64,
+}
+
+impl LumpedMassModel {
+    /// Momaro-like masses: 34 kg body 0.15 m above the base origin, 3.3 kg at each knee,
+    /// 2.7 kg at each wheel axle.
+    pub fn momaro_like(robot: &RobotDescription) -> Self {
+        Self {
+            robot: robot.clone(),
+            body_mass: 34.0,
+            body_com: [0.0, 0.0, 0.15],
+            knee_mass: 3.3,
+            wheel_mass: 2.7,
+        }
+    }
+}
+
+impl CenterOfMassModel for LumpedMassModel {
+    fn com(
+        &mut self,
+        base_position: [f64; 3],
+        base_rpy: [f64; 3],
+        legs: &[[f64; 3]; 4],
+    ) -> [f64; 3] {
+        let r = rotation(base_rpy);
+        let world = |p: [f64; 3]| kinematics::apply(&r, base_position, p);
+        let mut sum = [0.0; 3];
+        let mut mass = 0.0;
+        let mut add = |p: [f64; 3], m: f64| {
+            for k in 0..3 {
+                sum[k] += m * p[k];
+            }
+            mass += m;
+        };
+        add(world(self.body_com), self.body_mass);
+        let rb = &self.robot;
+        for (i, q) in legs.iter().enumerate() {
+            let h = rb.hips[i];
+            let knee =
+                [h[0] - rb.thigh_length * q[0].sin(), h[1], h[2] - rb.thigh_length * q[0].cos()];
+            add(world(knee), self.knee_mass);
+            let c = leg_fk(rb, *q, base_rpy[1]);
+            let axle = [h[0] + c[0], h[1], h[2] + c[1] + rb.wheel_radius];
+            add(world(axle), self.wheel_mass);
+        }
+        if mass > 0.0 { sum.map(|v| v / mass) } else { base_position }
+    }
+}
