@@ -3,9 +3,9 @@
 //!
 //! Each 10 ms control tick: the measured base pose (optionally with seeded noise) goes to
 //! the B-spline path follower, whose twist goes through the omnidirectional wheel
-//! kinematics to steering and wheel targets; leg joint targets come from sagittal IK with
-//! each foot on the height map's ground and the base pitched by 70 % of the slope under the
-//! feet (Sec. VI-B), so the robot follows ramps. The stability monitor measures the margin
+//! kinematics to steering and wheel targets; leg joint targets come from the driving
+//! posture of `motion::kinematics` (each foot on the height map's ground, the base pitched by
+//! 70 % of the slope under the feet, Sec. VI-B), so the robot follows ramps. The stability monitor measures the margin
 //! of MuJoCo's CoM over the wheels MuJoCo reports in contact. The scenario's expectations
 //! decide the verdict.
 //!
@@ -18,12 +18,12 @@ use crate::control::path_follower::{FollowerConfig, FollowerError, FollowerStatu
 use crate::control::wheels::WheelKinematics;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor};
+use crate::motion::kinematics::{driving_posture, leg_joint_targets};
 use crate::progress::SimProgress;
-use crate::robot::ik::{IkError, leg_ik};
-use crate::robot::{Leg, RobotDescription};
+use crate::robot::Leg;
+use crate::robot::ik::IkError;
 use crate::scenario::{Scenario, Stepping};
 use crate::sim::{SimError, Simulation};
-use crate::terrain::HeightMap;
 use crate::viz::{Recorder, VizError};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -52,6 +52,14 @@ pub enum RunJobError {
     /// The cost layers for the recording could not be built.
     #[error(transparent)]
     Cost(#[from] crate::cost::CostError),
+    /// The robot stands where the height map knows no ground.
+    #[error("no ground height known under a foot at ({x:.3}, {y:.3})")]
+    UnknownGround {
+        /// x, m.
+        x: f64,
+        /// y, m.
+        y: f64,
+    },
     /// The follower rejected the path or its configuration.
     #[error("path follower: {0}")]
     Follower(#[from] FollowerError),
@@ -173,53 +181,6 @@ impl Noise {
         let (u1, u2) = (self.uniform(), self.uniform());
         (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
     }
-}
-
-/// Leg joint targets that put every foot (at its neutral x' offset) on the ground of
-/// `heights` with the base `leg_height` above the mean ground under the feet and pitched by
-/// `pitch_fraction` of the slope between front and rear feet (Sec. VI-B).
-///
-/// Returns the targets and the commanded pitch (rad, MuJoCo's sign: positive nose down).
-///
-/// # Errors
-/// [`IkError`] if a foot is out of reach.
-pub fn driving_leg_targets(
-    robot: &RobotDescription,
-    heights: &HeightMap,
-    pose: &Pose2,
-    leg_height: f64,
-    pitch_fraction: f64,
-) -> Result<([[f64; 3]; 4], f64), IkError> {
-    let feet = robot.neutral_footprint();
-    let ground: [f64; 4] = std::array::from_fn(|i| {
-        let w = pose.transform(feet[i]);
-        heights.bilinear(w[0], w[1]).or_else(|| heights.height_at_cell(w[0], w[1])).unwrap_or(0.0)
-    });
-    let front = (ground[0] + ground[1]) / 2.0;
-    let rear = (ground[2] + ground[3]) / 2.0;
-    let dx = (feet[0][0] + feet[1][0] - feet[2][0] - feet[3][0]) / 2.0;
-    let slope = if dx.abs() > 1e-9 { ((front - rear) / dx).atan() } else { 0.0 };
-    // Nose up on an upward slope: negative rotation about y.
-    let pitch = -pitch_fraction * slope;
-    let (s, c) = pitch.sin_cos();
-    // Base height so that the mean hip is `leg_height` above the mean ground.
-    let base_z = (0..4)
-        .map(|i| {
-            let h = robot.hips[i];
-            ground[i] + leg_height - (-h[0] * s + h[2] * c)
-        })
-        .sum::<f64>()
-        / 4.0;
-    let mut q = [[0.0; 3]; 4];
-    for leg in Leg::ALL {
-        let i = leg.index();
-        let h = robot.hips[i];
-        let x = feet[i][0];
-        // Base-frame z' of a point at base-frame x' whose world height is ground[i].
-        let z = (ground[i] - base_z + x * s) / c;
-        q[i] = leg_ik(robot, leg, [x - h[0], z - h[2]], pitch)?;
-    }
-    Ok((q, pitch))
 }
 
 fn expectations(scenario: &Scenario, s: &RunSummary) -> Vec<ExpectationResult> {
@@ -348,13 +309,16 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
             finished = true;
             break;
         }
-        let (legs, _pitch) = driving_leg_targets(
+        // Leg heights from the height map, base pitched by 70 % of the slope (Sec. VI-B).
+        let posture = driving_posture(
             &robot,
-            &heights,
             &truth,
             params.driving_leg_height_m,
             params.base_pitch_slope_fraction,
-        )?;
+            |x, y| heights.bilinear(x, y).or_else(|| heights.height_at_cell(x, y)),
+        )
+        .map_err(|[x, y]| RunJobError::UnknownGround { x, y })?;
+        let legs = leg_joint_targets(&robot, &posture)?;
         let steer = Leg::ALL.map(|l| sim.steering_angle(l));
         let commands = kin.commands(&robot, out.twist, &feet, &steer);
         for leg in Leg::ALL {

@@ -5,7 +5,8 @@
 //!
 //! - **Driving** (drive / turn elements): one keyframe per path pose, feet in the neutral
 //!   footprint on the height map. At driving height (0.27 m) the mean hip stands that high
-//!   above the mean ground under the feet (as `jobs::run::driving_leg_targets`); while
+//!   above the mean ground under the feet (`kinematics::driving_posture`, which the closed loop
+//!   uses too); while
 //!   standing (between close manoeuvres) the manoeuvre leg-height rule below applies. The
 //!   base pitch is 70 % of the ground slope between front and rear feet (Sec. VI-B).
 //! - **Stand up / lower** (Fig. 13b, n): before the first non-driving manoeuvre the robot
@@ -44,6 +45,7 @@
 
 use super::CenterOfMassModel;
 use super::keyframe::{DetailedPath, Keyframe, Phase};
+use super::kinematics;
 use super::kinematics::{Evaluation, Posture, contacts_in_base, evaluate, interpolate, rotation};
 use super::roll::roll_for_lateral_com;
 use crate::cost::CostMaps;
@@ -216,33 +218,19 @@ impl Expander<'_> {
 
     /// Base pitch: `pitch_fraction` of the slope between the front and rear feet.
     fn pitch_for(&self, feet: &[[f64; 3]; 4], yaw: f64) -> f64 {
-        let (s, c) = yaw.sin_cos();
-        let along = |f: [f64; 3]| c * f[0] + s * f[1];
-        let dx = (along(feet[0]) + along(feet[1]) - along(feet[2]) - along(feet[3])) / 2.0;
-        let dz = (feet[0][2] + feet[1][2] - feet[2][2] - feet[3][2]) / 2.0;
-        let slope = if dx.abs() > 1e-6 { (dz / dx).atan() } else { 0.0 };
-        -self.o.pitch_fraction * slope
+        kinematics::pitch_from_feet(feet, yaw, self.o.pitch_fraction)
     }
 
-    /// Driving posture at `pose`: mean hip `driving_leg_height_m` above the mean ground.
+    /// Driving posture at `pose` (Sec. VI-B, [`kinematics::driving_posture`]).
     fn driving(&self, pose: &Pose2) -> Result<Posture, MotionError> {
-        let feet = self.neutral_feet(pose)?;
-        let pitch = self.pitch_for(&feet, pose.theta);
-        let r = rotation([0.0, pitch, pose.theta]);
-        let z = (0..4)
-            .map(|i| {
-                let h = self.robot.hips[i];
-                let dz = r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2];
-                feet[i][2] + self.o.driving_leg_height_m - dz
-            })
-            .sum::<f64>()
-            / 4.0;
-        Ok(Posture {
-            base_position: [pose.x, pose.y, z],
-            base_rpy: [0.0, pitch, pose.theta],
-            feet,
-            contact: [true; 4],
-        })
+        kinematics::driving_posture(
+            self.robot,
+            pose,
+            self.o.driving_leg_height_m,
+            self.o.pitch_fraction,
+            |x, y| self.maps.height_at(x, y),
+        )
+        .map_err(|[x, y]| MotionError::UnknownTerrain { index: self.index, x, y })
     }
 
     /// Standing posture: base height from the highest relevant ground (`ground`, per leg)

@@ -9,6 +9,7 @@
 //! (Sec. VI-A) and is bounded by [`MAX_LATERAL_MISMATCH_M`] for feet in contact.
 
 use super::CenterOfMassModel;
+use crate::geometry::Pose2;
 use crate::robot::ik::{IkError, leg_ik};
 use crate::robot::{Leg, RobotDescription};
 use crate::stability::{convex_hull, stability_margin};
@@ -164,6 +165,68 @@ pub fn evaluate(
     Ok(Evaluation { joints, leg_heights, com, margin, centroid_distance })
 }
 
+/// Base pitch for feet `feet` under a base heading `yaw` (Sec. VI-B): `pitch_fraction` of
+/// the ground slope between the mean front and mean rear foot, with MuJoCo's sign (nose up
+/// on an upward slope is negative).
+pub fn pitch_from_feet(feet: &[[f64; 3]; 4], yaw: f64, pitch_fraction: f64) -> f64 {
+    let (s, c) = yaw.sin_cos();
+    let along = |f: [f64; 3]| c * f[0] + s * f[1];
+    let dx = (along(feet[0]) + along(feet[1]) - along(feet[2]) - along(feet[3])) / 2.0;
+    let dz = (feet[0][2] + feet[1][2] - feet[2][2] - feet[3][2]) / 2.0;
+    let slope = if dx.abs() > 1e-6 { (dz / dx).atan() } else { 0.0 };
+    -pitch_fraction * slope
+}
+
+/// The driving posture at `pose` (Sec. VI-B): the feet in the neutral footprint on the
+/// ground that `ground(x, y)` gives, the base pitched by `pitch_fraction` of the slope and
+/// its mean hip `leg_height` above the mean ground under the feet.
+///
+/// # Errors
+/// The (x, y) of a foot where `ground` knows no height.
+pub fn driving_posture(
+    robot: &RobotDescription,
+    pose: &Pose2,
+    leg_height: f64,
+    pitch_fraction: f64,
+    ground: impl Fn(f64, f64) -> Option<f64>,
+) -> Result<Posture, [f64; 2]> {
+    let neutral = robot.neutral_footprint();
+    let mut feet = [[0.0; 3]; 4];
+    for (f, n) in feet.iter_mut().zip(neutral) {
+        let [x, y] = pose.transform(n);
+        *f = [x, y, ground(x, y).ok_or([x, y])?];
+    }
+    let pitch = pitch_from_feet(&feet, pose.theta, pitch_fraction);
+    let r = rotation([0.0, pitch, pose.theta]);
+    let z = (0..4)
+        .map(|i| {
+            let h = robot.hips[i];
+            feet[i][2] + leg_height - (r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2])
+        })
+        .sum::<f64>()
+        / 4.0;
+    Ok(Posture {
+        base_position: [pose.x, pose.y, z],
+        base_rpy: [0.0, pitch, pose.theta],
+        feet,
+        contact: [true; 4],
+    })
+}
+
+/// Joint targets (hip, knee, ankle) that put each leg's wheel on its foot of `p`.
+///
+/// # Errors
+/// [`IkError`] if a foot is out of reach or a joint limit would be passed.
+pub fn leg_joint_targets(robot: &RobotDescription, p: &Posture) -> Result<[[f64; 3]; 4], IkError> {
+    let local = contacts_in_base(robot, p);
+    let mut joints = [[0.0; 3]; 4];
+    for leg in Leg::ALL {
+        let c = local[leg.index()];
+        joints[leg.index()] = leg_ik(robot, leg, [c[0], c[2]], p.base_rpy[1])?;
+    }
+    Ok(joints)
+}
+
 /// Linear interpolation of two postures at `t` ∈ [0, 1] (base pose and feet; yaw along the
 /// shorter way). Contacts: a foot bears weight only if it does at both ends.
 pub fn interpolate(a: &Posture, b: &Posture, t: f64) -> Posture {
@@ -184,6 +247,38 @@ pub fn interpolate(a: &Posture, b: &Posture, t: f64) -> Posture {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn driving_posture_on_a_slope_by_hand() {
+        // Ground rising 0.1 per metre along +x; the feet at x = ±0.35 m see ±0.035 m, so the
+        // slope between front and rear is atan(0.1) and the pitch −0.7·atan(0.1). The mean
+        // ground is 0, so the base origin sits 0.27 m plus the hips' offset above it:
+        // z = 0.27 − (−0.05)·cos(pitch) (the hips are 0.05 m below the origin, at x' = ±0.35
+        // whose pitch terms cancel).
+        let robot = RobotDescription::reference();
+        let p =
+            driving_posture(&robot, &Pose2::new(0.0, 0.0, 0.0), 0.27, 0.7, |x, _| Some(0.1 * x))
+                .unwrap();
+        let pitch = -0.7 * 0.1f64.atan();
+        assert!((p.base_rpy[1] - pitch).abs() < 1e-12);
+        assert!((p.base_position[2] - (0.27 + 0.05 * pitch.cos())).abs() < 1e-12);
+        assert!((p.feet[0][2] - 0.035).abs() < 1e-12 && (p.feet[2][2] + 0.035).abs() < 1e-12);
+        // The joint targets put each wheel back on its foot.
+        let q = leg_joint_targets(&robot, &p).unwrap();
+        let local = contacts_in_base(&robot, &p);
+        for leg in Leg::ALL {
+            let f = crate::robot::ik::leg_fk(&robot, q[leg.index()], p.base_rpy[1]);
+            assert!(
+                (f[0] - local[leg.index()][0]).abs() < 1e-9
+                    && (f[1] - local[leg.index()][2]).abs() < 1e-9
+            );
+        }
+        // Unknown ground names where.
+        let e = driving_posture(&robot, &Pose2::new(0.0, 0.0, 0.0), 0.27, 0.7, |x, _| {
+            (x < 0.0).then_some(0.0)
+        });
+        assert_eq!(e.unwrap_err(), [0.35, 0.32]);
+    }
 
     #[test]
     fn rotation_matches_zyx_convention() {
