@@ -81,6 +81,20 @@ fn before_rear_step_up(p: &PlanSummary, n: usize) -> usize {
         .unwrap_or(p.path.len())
 }
 
+/// Prints the expansion's figures (seen with `cargo test -- --nocapture`).
+fn report(s: &Scenario, end: usize, total: usize, d: &DetailedPath) {
+    println!(
+        "{}: {end} of {total} elements, {} steps, {} keyframes, {} postures, min margin {:.3} m (keyframes {:.3}, three contacts {:.3})",
+        s.name,
+        d.steps,
+        d.keyframes.len(),
+        d.samples_checked,
+        d.min_margin_m,
+        d.min_keyframe_margin_m,
+        d.min_three_contact_margin_m
+    );
+}
+
 #[test]
 fn staircase_front_steps_and_first_rear_step_are_stable() {
     let s = scenario("staircase");
@@ -90,18 +104,7 @@ fn staircase_front_steps_and_first_rear_step_are_stable() {
     // and the first rear-left step.
     let end = before_rear_step_up(&p, 1);
     let d = expand(&s, &mut sim, &p.path[..end]).expect("expansion");
-    println!(
-        "{}: {} of {} elements, {} steps, {} keyframes, {} postures, min margin {:.3} m (keyframes {:.3}, three contacts {:.3})",
-        s.name,
-        end,
-        p.path.len(),
-        d.steps,
-        d.keyframes.len(),
-        d.samples_checked,
-        d.min_margin_m,
-        d.min_keyframe_margin_m,
-        d.min_three_contact_margin_m
-    );
+    report(&s, end, p.path.len(), &d);
     check(&d, &sim);
     let ph = phases(&d);
     for want in [
@@ -132,18 +135,7 @@ fn platform_path_up_to_the_rear_steps_onto_the_platform_is_stable() {
     let p = planned(&s, &sim);
     let end = before_rear_step_up(&p, 0);
     let d = expand(&s, &mut sim, &p.path[..end]).expect("expansion");
-    println!(
-        "{}: {} of {} elements, {} steps, {} keyframes, {} postures, min margin {:.3} m (keyframes {:.3}, three contacts {:.3})",
-        s.name,
-        end,
-        p.path.len(),
-        d.steps,
-        d.keyframes.len(),
-        d.samples_checked,
-        d.min_margin_m,
-        d.min_keyframe_margin_m,
-        d.min_three_contact_margin_m
-    );
+    report(&s, end, p.path.len(), &d);
     check(&d, &sim);
     assert!(d.steps >= 2, "front steps onto the platform: {}", d.steps);
     let ph = phases(&d);
