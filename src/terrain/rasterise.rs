@@ -268,27 +268,8 @@ fn disc_overlaps_cell(center: [f64; 2], radius: f64, cell: [f64; 4]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scenario::terrain::terrain_height;
 
     const RES: f64 = 0.025;
-
-    /// Highest of `terrain_height` over a dense grid of points in the cell (including
-    /// points a hair inside each edge): a sampled lower bound of the exact cell maximum.
-    fn sampled_max(ps: &[Primitive], m: &HeightMap, i: usize, j: usize) -> f64 {
-        let [x0, y0] = [m.origin()[0] + i as f64 * RES, m.origin()[1] + j as f64 * RES];
-        let fr = |k: usize| match k {
-            0 => 1e-7,
-            10 => 1.0 - 1e-7,
-            _ => k as f64 / 10.0,
-        };
-        let mut best = f64::NEG_INFINITY;
-        for a in 0..=10 {
-            for b in 0..=10 {
-                best = best.max(terrain_height(ps, x0 + fr(a) * RES, y0 + fr(b) * RES));
-            }
-        }
-        best
-    }
 
     #[test]
     fn axis_aligned_box_on_cell_boundaries_claims_exactly_its_cells() {
@@ -369,7 +350,7 @@ mod tests {
         for j in 0..m.ny() {
             for i in 0..m.nx() {
                 let exact = m.get(i, j).unwrap();
-                let sampled = sampled_max(&ps, &m, i, j);
+                let [_, sampled] = crate::terrain::sensed::sampled_height_range(&ps, &m, i, j);
                 // Sampling can only miss a sliver: never above the exact value, and within
                 // a ramp's rise over a tenth of a cell diagonal of it for most cells.
                 assert!(sampled <= exact + 1e-9, "({i},{j}) sampled {sampled} > {exact}");

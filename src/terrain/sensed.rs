@@ -318,10 +318,16 @@ pub struct ScanStats {
     pub outside_map: usize,
 }
 
-/// Lowest terrain surface over cell (i, j) of `map`, sampled on an 11 × 11 grid that
-/// includes points a hair inside each edge. With the rasterised value (the highest surface)
-/// it bounds what a sensor may legitimately report for the cell.
-pub fn sampled_min_height(primitives: &[Primitive], map: &HeightMap, i: usize, j: usize) -> f64 {
+/// Lowest and highest terrain surface over cell (i, j) of `map`, sampled on an 11 × 11
+/// grid that includes points a hair inside each edge. The minimum, with the rasterised value
+/// (the exact highest surface), bounds what a sensor may legitimately report for the cell;
+/// the maximum is a sampled lower bound of that rasterised value.
+pub fn sampled_height_range(
+    primitives: &[Primitive],
+    map: &HeightMap,
+    i: usize,
+    j: usize,
+) -> [f64; 2] {
     let o = map.origin();
     let res = map.resolution();
     let fr = |k: usize| match k {
@@ -329,15 +335,16 @@ pub fn sampled_min_height(primitives: &[Primitive], map: &HeightMap, i: usize, j
         10 => 1.0 - 1e-7,
         _ => k as f64 / 10.0,
     };
-    let mut lo = f64::INFINITY;
+    let mut range = [f64::INFINITY, f64::NEG_INFINITY];
     for a in 0..=10 {
         for b in 0..=10 {
             let x = o[0] + (i as f64 + fr(a)) * res;
             let y = o[1] + (j as f64 + fr(b)) * res;
-            lo = lo.min(terrain_height(primitives, x, y));
+            let h = terrain_height(primitives, x, y);
+            range = [range[0].min(h), range[1].max(h)];
         }
     }
-    lo
+    range
 }
 
 /// How a sensed map compares with the rasterised map of the same terrain and grid.
@@ -374,7 +381,7 @@ pub fn agreement(
     for j in 0..raster.ny().min(sensed.ny()) {
         for i in 0..raster.nx().min(sensed.nx()) {
             let Some(hi) = raster.get(i, j) else { continue };
-            let lo = sampled_min_height(primitives, raster, i, j);
+            let [lo, _] = sampled_height_range(primitives, raster, i, j);
             let edge = hi - lo > tolerance;
             a.edge_total += usize::from(edge);
             let Some(s) = sensed.get(i, j) else { continue };
