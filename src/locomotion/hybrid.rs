@@ -38,10 +38,10 @@
 //!   the scans.
 //! - *Support for a step.* The paper leaves static stability to the step motion
 //!   generator. A plan whose step no alignment can stabilise is useless to it, so a step
-//!   also needs the base centre (about where the CoM projects) inside the support
-//!   triangle of the other three feet, with the partner wheel driven toward the centre as
-//!   far as the generator may (`Params::step_support_margin_m`, 5 cm): roll and a base
-//!   shift align the rest.
+//!   also needs a CoM estimate (`motion::standing::com_estimate`: base body and legs
+//!   lumped, the robot standing by the rule) inside the support triangle of the other
+//!   three feet, with the partner wheel driven toward the centre as far as the generator
+//!   may (`Params::step_support_margin_m`): roll and a base shift align the rest.
 //! - *Which footholds count as a step.* A step must carry the foot *over* untraversable
 //!   terrain: its straight sagittal line crosses at least one cell of infinite foot cost.
 //!   A foothold reachable over finite cells only is a wheel drive (front foot forward /
@@ -72,7 +72,7 @@ use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Nei
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::geometry::Pose2;
 use crate::motion::kinematics::hips_in_world;
-use crate::motion::standing::StandingRule;
+use crate::motion::standing::{StandingRule, com_estimate};
 use crate::params::Params;
 use crate::planner::{Cost, SearchGraph};
 use crate::robot::ik::leg_ik;
@@ -772,14 +772,13 @@ impl<'c> HybridGraph<'c> {
         }
     }
 
-    /// Whether the base centre of state `s` lies in the support triangle of a step of
+    /// Whether the CoM estimate of state `s` standing by the rule
+    /// ([`com_estimate`]) lies in the support triangle of a step of
     /// `leg` to `post` (x, y) with at least `step_support_margin_m`: the triangle of the
     /// other three feet, the partner on the stepping side driven toward the centre as far
     /// as the generator may (`max_wheel_to_centre_m`, keeping `wheel_gap_m` to the
     /// stepping foot at both ends, stopping before untraversable cells and height
-    /// changes), as in Sec. VI-A. The CoM projects near the base centre (up to about 5 cm
-    /// behind it with the base pitched on stairs, which the margin covers); roll and a base
-    /// shift align the rest.
+    /// changes), as in Sec. VI-A. Roll and a base shift align the rest.
     fn step_supported(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
         let p = self.lattice.pose(s);
         let (hx, hy) = self.heading(s.theta);
@@ -813,7 +812,12 @@ impl<'c> HybridGraph<'c> {
             .filter(|&k| k != leg)
             .map(|k| if k == partner { moved } else { feet.pos[k] })
             .collect();
-        stability_margin(&support, [p.x, p.y]) >= c.step_support_margin_m
+        let Ok((stance, _)) =
+            c.standing.stand(&self.robot, Self::feet_xyz(feet), [p.x, p.y], p.theta)
+        else {
+            return false;
+        };
+        stability_margin(&support, com_estimate(&self.robot, &stance)) >= c.step_support_margin_m
     }
 
     /// Whether the robot can stand by the rule with its base `l` cells ahead of state
