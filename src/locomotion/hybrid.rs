@@ -56,6 +56,7 @@
 
 use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, edge_cost};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
+use super::heuristic::{StepBound, StepBoundParams};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::geometry::Pose2;
@@ -64,6 +65,7 @@ use crate::planner::{Cost, SearchGraph};
 use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
 use serde::Serialize;
+use std::time::{Duration, Instant};
 
 /// What an edge of the hybrid graph does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -242,6 +244,10 @@ pub struct HybridGraph<'c> {
     /// Scratch buffer for the labelled special successors.
     special: Vec<(LatticeState, Cost, Manoeuvre)>,
     stats: ManoeuvreStats,
+    /// The step-cost part of the heuristic (`heuristic`), built once per graph.
+    step_bound: StepBound,
+    /// Time spent building `step_bound`.
+    heuristic_setup: Duration,
 }
 
 /// The offsets (cells, −64..=63) at which `leg` reaches its foot with the hip `height`
@@ -297,10 +303,14 @@ impl<'c> HybridGraph<'c> {
         let reach = union.map(bit_range);
         let trig = (0..lattice.orientations).map(|k| lattice.yaw(k as u8).sin_cos()).collect();
         let foot_move_cells = (config.foot_move_increment_m / res).round().clamp(1.0, 127.0) as i8;
+        let near = near_obstacle_layer(maps, config.step_obstacle_distance_m);
+        let t0 = Instant::now();
+        let step_bound = build_step_bound(maps, &near, &config, &lattice, goal);
+        let heuristic_setup = t0.elapsed();
         Ok(Self {
             maps,
             driving: DrivingGraph::new(maps, lattice, config.driving, goal),
-            near: near_obstacle_layer(maps, config.step_obstacle_distance_m),
+            near,
             config,
             lattice,
             neutral: maps.neutral_footprint(),
@@ -311,7 +321,20 @@ impl<'c> HybridGraph<'c> {
             foot_move_cells,
             special: Vec::with_capacity(16),
             stats: ManoeuvreStats::default(),
+            step_bound,
+            heuristic_setup,
         })
+    }
+
+    /// Time spent building the heuristic's step bound when the graph was made (not part
+    /// of any search's time).
+    pub fn heuristic_setup_time(&self) -> Duration {
+        self.heuristic_setup
+    }
+
+    /// Number of foot components the step bound found (0: no step bound).
+    pub fn step_bound_components(&self) -> usize {
+        self.step_bound.components()
     }
 
     /// The lattice.
@@ -841,6 +864,40 @@ impl<'c> HybridGraph<'c> {
     }
 }
 
+/// The step bound of the heuristic for `goal` (every orientation when the goal leaves it
+/// free). The link radius covers the largest jump of a foot's cell in a drive (2), a
+/// turn (the chord of the widest foot) and a base shift (1), plus one against rounding.
+fn build_step_bound(
+    maps: &CostMaps,
+    near: &[bool],
+    config: &HybridConfig,
+    lattice: &Lattice,
+    goal: DrivingGoal,
+) -> StepBound {
+    let res = lattice.resolution;
+    let radius = maps.neutral_footprint().iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
+    let chord = 2.0 * radius * (0.5 * lattice.orientation_step()).sin();
+    let chord_cells = if lattice.orientations > 1 { (chord / res).ceil() } else { 0.0 };
+    let link_cells = chord_cells.clamp(2.0, 1000.0) as usize + 1;
+    let params = StepBoundParams {
+        step_cost_factor: config.step_cost_factor,
+        k7: config.k7,
+        k8: config.k8,
+        k9: config.k9,
+        max_step_height_m: config.max_step_height_m,
+        link_cells,
+    };
+    let thetas: Vec<u8> = match goal.theta {
+        Some(t) => vec![t],
+        None => (0..lattice.orientations).map(|k| k as u8).collect(),
+    };
+    let goal_feet: Vec<[[f64; 2]; 4]> = thetas
+        .into_iter()
+        .map(|theta| maps.neutral_feet(&lattice.pose(LatticeState::new(goal.i, goal.j, theta))))
+        .collect();
+    StepBound::build(maps, near, &params, &goal_feet)
+}
+
 /// The criterion-1 pre-filter: per cell, whether an infinite-foot-cost cell's centre lies
 /// within `radius` plus half a cell diagonal of the cell's centre (so for every point of
 /// the cell, "an infinite cell closer than `radius`" implies the flag). Stamps a disc
@@ -900,8 +957,16 @@ impl SearchGraph for HybridGraph<'_> {
         out.extend(self.special.iter().map(|&(t, c, _)| (t, c)));
     }
 
+    /// The driving heuristic (Euclidean distance plus turn, [`DrivingGraph`]) plus the
+    /// step bound Σ_k S_k of the four feet (`heuristic` module): consistent on every
+    /// manoeuvre (see the module docs of both).
     fn heuristic(&self, s: LatticeState) -> Cost {
-        self.driving.heuristic(s)
+        let h = self.driving.heuristic(s);
+        let Some(o) = self.footprints.get(s.footprint) else {
+            return h;
+        };
+        let feet = self.feet_pos(s, &o);
+        h.saturating_add(self.step_bound.lower_bound(self.maps, &feet))
     }
 
     fn is_goal(&self, s: LatticeState) -> bool {

@@ -13,6 +13,7 @@
 
 pub mod driving;
 pub mod footprint;
+pub mod heuristic;
 pub mod hybrid;
 pub mod lattice;
 pub mod orientation;

@@ -1,0 +1,252 @@
+//! A lower bound on the step costs still needed to reach the goal: the informed part of
+//! the hybrid graph's heuristic ([`super::HybridGraph`]), computed once per plan.
+//!
+//! **Idea.** Every foot stands on a cell of finite foot cost C_F (eq. 1) in every state
+//! of the hybrid graph, and the only manoeuvre that carries a foot across untraversable
+//! terrain is an abstract step (Sec. V). So we split the finite-C_F cells into
+//! *components* — sets a foot can roll between without stepping — and lower-bound, per
+//! component and per foot, the sum of the step costs C_S (eq. 5, times the step-related
+//! factor) that foot still has to pay before it stands where the goal pose puts it. The
+//! four feet's bounds add up, because each step moves exactly one foot.
+//!
+//! **Components.** Two finite-C_F cells are *linked* when they are at most `R` cells
+//! apart along each axis (Chebyshev distance ≤ R); components are the connected sets of
+//! this relation. R bounds how far a foot's cell jumps in one manoeuvre that is not a
+//! step:
+//! - a driving move translates the base, hence every foot, by at most 2 cells per axis
+//!   (the 16- / 20-neighbourhood);
+//! - a turn on the spot moves a foot on a chord of `2 r sin(Δθ/2)` (r its distance from
+//!   the base centre, Δθ one orientation step), so its cell by at most
+//!   `⌈chord / res⌉` per axis;
+//! - a base shift leaves the feet where they stand up to the snap of the base to its
+//!   cell (half a cell diagonal, ≤ 1 cell per axis);
+//! - front foot forward and foot to neutral drive one foot along a line whose every
+//!   cell (sampled each `res`) has finite C_F: consecutive cells ≤ 1 apart per axis;
+//!
+//! with one cell added against float rounding: `R = max(2, ⌈chord / res⌉) + 1`. Both
+//! ends of each of these manoeuvres are finite-C_F cells (they are states' feet, or line
+//! cells checked finite), so they never change a foot's component.
+//!
+//! **Step edges between components.** A step of one foot from cell a (component A) to
+//! cell b (component B) costs `f · C_S` with `C_S = k7 · L + k8 · (C_F(b) − 1) + k9 · ΔH`
+//! (eq. 5; f the step-related factor). Each term is bounded below from the components
+//! alone:
+//! - `ΔH ≥ |H(b) − H(a)|` (ΔH_step is the largest height difference over the cells the
+//!   foot passes, the landing cell included) `≥ gap(A, B)`, the distance between the
+//!   components' height intervals `[min H, max H]`; a pair whose gap exceeds the largest
+//!   step height (criterion 3) has no step at all;
+//! - `C_F(b) ≥ min C_F over B`;
+//! - `L = d · res` with d ≥ 2 (the foot crosses at least one infinite cell and lands on
+//!   a finite one after it); between different components the cell centres are more
+//!   than R cells apart along some axis, so `|c_b − c_a| ≥ (R + 1) · res` and, with both
+//!   foot positions within half a cell diagonal of their cell centres,
+//!   `L ≥ (R + 1 − √2) · res`;
+//! - a step starts only from a foot within `step_obstacle_distance_m` of an infinite
+//!   cell (criterion 1), so only components holding a cell of the graph's conservative
+//!   "near an obstacle" layer have outgoing step edges.
+//!
+//! The component graph with these edge weights `w(A, B)` (B = A included) is searched
+//! backwards from the component of each goal foot (Dijkstra, dense, O(K²) for K
+//! components): `S_k(A)` is the cheapest chain of steps from A to foot k's goal
+//! component.
+//!
+//! **Consistency.** For a step of foot k from a ∈ A to b ∈ B: `S_k(A) ≤ w(A, B) + S_k(B)`
+//! (Dijkstra) `≤ c + S_k(B)`, and the other feet's terms do not change. Every other
+//! manoeuvre leaves all four components, hence the bound, unchanged. So `Σ_k S_k` is
+//! consistent on its own with respect to the step edges and invariant on all others; it
+//! is zero at the goal. Added to the driving heuristic (Euclidean distance plus turn,
+//! consistent with respect to drives, turns and base shifts and unchanged by steps and
+//! foot moves), the sum is consistent for every edge of the hybrid graph. Weights are
+//! rounded down to the micro-unit with a relative slack of 10⁻⁹ (edges round up), and
+//! the Dijkstra sums integers, so the bound holds exactly in fixed point.
+//!
+//! Maps with more than [`MAX_COMPONENTS`] components get no step bound (the bound is
+//! then zero everywhere, which is trivially consistent): the O(K²) search would cost
+//! more than it saves.
+
+use crate::cost::{Cost as CostValue, CostMaps};
+use crate::planner::Cost;
+
+/// Largest number of components for which the step bound is computed.
+pub const MAX_COMPONENTS: usize = 2048;
+
+/// "No component": the cell's foot cost is not finite.
+const NONE: u32 = u32::MAX;
+
+/// The constants of the step cost the bound needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepBoundParams {
+    /// Factor on every step-related manoeuvre (Sec. V, Fig. 7).
+    pub step_cost_factor: f64,
+    /// k7 (eq. 5): weight on the step length.
+    pub k7: f64,
+    /// k8 (eq. 5): weight on the foothold cost.
+    pub k8: f64,
+    /// k9 (eq. 5): weight on the step height.
+    pub k9: f64,
+    /// Criterion 3: largest height difference of a step, m.
+    pub max_step_height_m: f64,
+    /// Link radius R, cells (see the module docs).
+    pub link_cells: usize,
+}
+
+/// One component's summary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Component {
+    min_h: f64,
+    max_h: f64,
+    min_cf: f64,
+    /// Holds a cell of the "near an obstacle" layer: steps may start here.
+    near: bool,
+}
+
+/// Per-cell components and per-foot step bounds (see the module docs).
+#[derive(Debug, Clone)]
+pub struct StepBound {
+    /// Component per cell (row-major, as the height map), [`NONE`] where C_F is not finite.
+    comp: Vec<u32>,
+    /// Per foot (FL, FR, RL, RR), per component: the step cost still needed, S_k.
+    per_foot: [Vec<Cost>; 4],
+    components: usize,
+}
+
+impl StepBound {
+    /// A bound that is zero everywhere.
+    pub fn zero() -> Self {
+        Self { comp: Vec::new(), per_foot: Default::default(), components: 0 }
+    }
+
+    /// Builds the bound on `maps` for the goal foot positions `goal_feet` (one array of
+    /// four per accepted goal orientation; foot k of every entry is a source for foot k).
+    /// `near` is the graph's per-cell "near an obstacle" layer (a superset of the cells
+    /// from which criterion 1 allows a step).
+    pub fn build(
+        maps: &CostMaps,
+        near: &[bool],
+        params: &StepBoundParams,
+        goal_feet: &[[[f64; 2]; 4]],
+    ) -> Self {
+        let hm = maps.heights();
+        let (nx, ny) = hm.dims();
+        let res = hm.resolution();
+        let r = params.link_cells.max(1) as isize;
+        let finite = |i: usize, j: usize| match maps.foot_cost_cell(i, j) {
+            CostValue::Finite(c) => hm.get(i, j).map(|h| (c, h)),
+            _ => None,
+        };
+        // Components: breadth-first over linked finite cells.
+        let mut comp = vec![NONE; nx * ny];
+        let mut comps: Vec<Component> = Vec::new();
+        let mut queue = Vec::new();
+        for j0 in 0..ny {
+            for i0 in 0..nx {
+                if comp[j0 * nx + i0] != NONE {
+                    continue;
+                }
+                let Some((cf, h)) = finite(i0, j0) else { continue };
+                if comps.len() >= MAX_COMPONENTS {
+                    return Self::zero();
+                }
+                let id = comps.len() as u32;
+                let mut c = Component { min_h: h, max_h: h, min_cf: cf, near: false };
+                comp[j0 * nx + i0] = id;
+                queue.clear();
+                queue.push((i0, j0));
+                while let Some((i, j)) = queue.pop() {
+                    let (cf, h) = finite(i, j).unwrap_or((f64::INFINITY, f64::NAN));
+                    c.min_h = c.min_h.min(h);
+                    c.max_h = c.max_h.max(h);
+                    c.min_cf = c.min_cf.min(cf);
+                    c.near |= near.get(j * nx + i).copied().unwrap_or(false);
+                    let (i, j) = (i as isize, j as isize);
+                    for b in (j - r).max(0)..=(j + r).min(ny as isize - 1) {
+                        for a in (i - r).max(0)..=(i + r).min(nx as isize - 1) {
+                            let k = b as usize * nx + a as usize;
+                            if comp[k] == NONE && finite(a as usize, b as usize).is_some() {
+                                comp[k] = id;
+                                queue.push((a as usize, b as usize));
+                            }
+                        }
+                    }
+                }
+                comps.push(c);
+            }
+        }
+        let k = comps.len();
+        let l_other = ((r as f64 + 1.0 - std::f64::consts::SQRT_2) * res).max(2.0 * res);
+        let l_same = 2.0 * res;
+        let weight = |a: usize, b: usize| -> Option<Cost> {
+            let (ca, cb) = (&comps[a], &comps[b]);
+            if !ca.near {
+                return None;
+            }
+            let gap = (cb.min_h - ca.max_h).max(ca.min_h - cb.max_h).max(0.0);
+            if gap > params.max_step_height_m {
+                return None;
+            }
+            let l = if a == b { l_same } else { l_other };
+            let c_s = params.k7 * l + params.k8 * (cb.min_cf - 1.0) + params.k9 * gap;
+            Some(Cost::from_f64_floor(params.step_cost_factor * c_s * (1.0 - 1e-9)))
+        };
+        let per_foot = std::array::from_fn(|foot| {
+            let mut dist = vec![Cost::INFINITY; k];
+            for feet in goal_feet {
+                let [x, y] = feet[foot];
+                if let Some((i, j)) = hm.cell_of(x, y) {
+                    let c = comp[j * nx + i];
+                    if c != NONE {
+                        dist[c as usize] = Cost::ZERO;
+                    }
+                }
+            }
+            // Dense Dijkstra over the component graph, edges reversed.
+            let mut done = vec![false; k];
+            loop {
+                let next = (0..k)
+                    .filter(|&c| !done[c] && !dist[c].is_infinite())
+                    .min_by_key(|&c| (dist[c], c));
+                let Some(b) = next else { break };
+                done[b] = true;
+                for a in 0..k {
+                    if done[a] {
+                        continue;
+                    }
+                    if let Some(w) = weight(a, b) {
+                        let d = dist[b].saturating_add(w);
+                        if d < dist[a] {
+                            dist[a] = d;
+                        }
+                    }
+                }
+            }
+            dist
+        });
+        Self { comp, per_foot, components: k }
+    }
+
+    /// Number of components (0 for the zero bound).
+    pub fn components(&self) -> usize {
+        self.components
+    }
+
+    /// Σ_k S_k over the feet at world positions `feet` (FL, FR, RL, RR) on the map of
+    /// `maps`: the step cost still needed. A foot off the map or on a cell of non-finite
+    /// foot cost adds nothing; a foot that cannot reach its goal component makes the
+    /// bound [`Cost::INFINITY`].
+    #[inline]
+    pub fn lower_bound(&self, maps: &CostMaps, feet: &[[f64; 2]; 4]) -> Cost {
+        if self.components == 0 {
+            return Cost::ZERO;
+        }
+        let hm = maps.heights();
+        let mut sum = Cost::ZERO;
+        for (k, f) in feet.iter().enumerate() {
+            let Some((i, j)) = hm.cell_of(f[0], f[1]) else { continue };
+            let c = self.comp[j * hm.nx() + i];
+            if c != NONE {
+                sum = sum.saturating_add(self.per_foot[k][c as usize]);
+            }
+        }
+        sum
+    }
+}
