@@ -88,6 +88,10 @@ pub struct StepBoundParams {
     pub max_step_height_m: f64,
     /// Link radius R, cells (see the module docs).
     pub link_cells: usize,
+    /// k10: base shift weight (C_BS).
+    pub k10: f64,
+    /// k11 (eq. 6): single foot move weight.
+    pub k11: f64,
 }
 
 /// One component's summary.
@@ -108,12 +112,14 @@ pub struct StepBound {
     /// Per foot (FL, FR, RL, RR), per component: the step cost still needed, S_k.
     per_foot: [Vec<Cost>; 4],
     components: usize,
+    /// Weight of the foot-offset potential per cell of offset, cost units.
+    offset_per_cell: f64,
 }
 
 impl StepBound {
     /// A bound that is zero everywhere.
     pub fn zero() -> Self {
-        Self { comp: Vec::new(), per_foot: Default::default(), components: 0 }
+        Self { comp: Vec::new(), per_foot: Default::default(), components: 0, offset_per_cell: 0.0 }
     }
 
     /// Builds the bound on `maps` for the goal foot positions `goal_feet` (one array of
@@ -175,6 +181,10 @@ impl StepBound {
         let k = comps.len();
         let l_other = ((r as f64 + 1.0 - std::f64::consts::SQRT_2) * res).max(2.0 * res);
         let l_same = 2.0 * res;
+        let gaps = min_step_lengths(&comp, &comps, nx, ny, res, near);
+        let min_cf = comps.iter().map(|c| c.min_cf).fold(f64::INFINITY, f64::min);
+        let (offset_per_m, lambda) = offset_potential(params, min_cf);
+        let k7 = params.k7 * (1.0 - lambda);
         let weight = |a: usize, b: usize| -> Option<Cost> {
             let (ca, cb) = (&comps[a], &comps[b]);
             if !ca.near {
@@ -184,8 +194,12 @@ impl StepBound {
             if gap > params.max_step_height_m {
                 return None;
             }
-            let l = if a == b { l_same } else { l_other };
-            let c_s = params.k7 * l + params.k8 * (cb.min_cf - 1.0) + params.k9 * gap;
+            let l = if a == b {
+                l_same
+            } else {
+                gaps.as_ref().map_or(l_other, |g| g.get(a, b)).max(l_other)
+            };
+            let c_s = k7 * l + params.k8 * (cb.min_cf - 1.0) + params.k9 * gap;
             Some(Cost::from_f64_floor(params.step_cost_factor * c_s * (1.0 - 1e-9)))
         };
         let per_foot = std::array::from_fn(|foot| {
@@ -221,7 +235,12 @@ impl StepBound {
             }
             dist
         });
-        Self { comp, per_foot, components: k }
+        Self { comp, per_foot, components: k, offset_per_cell: offset_per_m * res }
+    }
+
+    /// The weight c of the foot-offset potential, per metre of offset.
+    pub fn offset_weight_per_m(&self, res: f64) -> f64 {
+        self.offset_per_cell / res
     }
 
     /// Number of components (0 for the zero bound).
@@ -249,4 +268,134 @@ impl StepBound {
         }
         sum
     }
+
+    /// The foot-offset potential Φ = c · Σ_k |o_k| of a footprint with offsets `o`
+    /// (cells), rounded down (see [`offset_potential`]).
+    #[inline]
+    pub fn offset_potential(&self, o: &[i8; 4]) -> Cost {
+        let cells: i32 = o.iter().map(|&v| i32::from(v).abs()).sum();
+        Cost::from_f64_floor(self.offset_per_cell * f64::from(cells) * (1.0 - 1e-9))
+    }
+}
+
+/// Lower bounds on step lengths between components, from octile distance transforms.
+struct StepLengths {
+    /// Row-major `[a · k + b]`, m.
+    lengths: Vec<f64>,
+    k: usize,
+}
+
+impl StepLengths {
+    fn get(&self, a: usize, b: usize) -> f64 {
+        self.lengths[a * self.k + b]
+    }
+}
+
+/// Largest number of components for which [`min_step_lengths`] runs a distance transform
+/// per component (each is two passes over the map).
+pub const MAX_DISTANCE_TRANSFORMS: usize = 32;
+
+/// For every pair (A, B) of components: a lower bound on the length L of a step from a
+/// cell of A flagged `near` to a cell of B, `d / 1.0824 − √2 · res` with d the octile
+/// distance between their cell centres (the octile distance is at most 1.0824 times the
+/// Euclidean one; the feet lie within half a cell diagonal of their cell centres).
+/// `None` for maps with more than [`MAX_DISTANCE_TRANSFORMS`] components.
+fn min_step_lengths(
+    comp: &[u32],
+    comps: &[Component],
+    nx: usize,
+    ny: usize,
+    res: f64,
+    near: &[bool],
+) -> Option<StepLengths> {
+    let k = comps.len();
+    if k > MAX_DISTANCE_TRANSFORMS {
+        return None;
+    }
+    let octile_over_euclid = (1.0 + (std::f64::consts::SQRT_2 - 1.0).powi(2)).sqrt();
+    let mut lengths = vec![0.0; k * k];
+    let mut d = vec![0.0_f64; nx * ny];
+    let diag = std::f64::consts::SQRT_2;
+    for b in 0..k {
+        for (v, &c) in d.iter_mut().zip(comp) {
+            *v = if c == b as u32 { 0.0 } else { f64::INFINITY };
+        }
+        // Two-pass chamfer transform with weights 1 and √2: the exact octile distance
+        // to the nearest cell of B.
+        for j in 0..ny {
+            for i in 0..nx {
+                let mut v = d[j * nx + i];
+                if i > 0 {
+                    v = v.min(d[j * nx + i - 1] + 1.0);
+                }
+                if j > 0 {
+                    v = v.min(d[(j - 1) * nx + i] + 1.0);
+                    if i > 0 {
+                        v = v.min(d[(j - 1) * nx + i - 1] + diag);
+                    }
+                    if i + 1 < nx {
+                        v = v.min(d[(j - 1) * nx + i + 1] + diag);
+                    }
+                }
+                d[j * nx + i] = v;
+            }
+        }
+        for j in (0..ny).rev() {
+            for i in (0..nx).rev() {
+                let mut v = d[j * nx + i];
+                if i + 1 < nx {
+                    v = v.min(d[j * nx + i + 1] + 1.0);
+                }
+                if j + 1 < ny {
+                    v = v.min(d[(j + 1) * nx + i] + 1.0);
+                    if i + 1 < nx {
+                        v = v.min(d[(j + 1) * nx + i + 1] + diag);
+                    }
+                    if i > 0 {
+                        v = v.min(d[(j + 1) * nx + i - 1] + diag);
+                    }
+                }
+                d[j * nx + i] = v;
+            }
+        }
+        let mut best = vec![f64::INFINITY; k];
+        for ((&c, &v), &n) in comp.iter().zip(&d).zip(near) {
+            if n && c != NONE && v < best[c as usize] {
+                best[c as usize] = v;
+            }
+        }
+        for a in 0..k {
+            let cells = best[a] / octile_over_euclid - diag;
+            lengths[a * k + b] = (cells * res * (1.0 - 1e-9)).max(0.0);
+        }
+    }
+    Some(StepLengths { lengths, k })
+}
+
+/// The weight c of the foot-offset potential `Φ = c · Σ_k |o_k|` (o_k in metres) that the
+/// hybrid heuristic adds for non-neutral footprints: every offset must be undone before
+/// the (neutral) goal. The largest `c` for which Φ stays consistent:
+///
+/// - foot to neutral / front foot forward drive one foot by |Δo| at cost
+///   `f · k11 · |Δo| · C_F,avg ≥ f · k11 · C_F,min · |Δo|` (eq. 6);
+/// - a base shift by L changes every offset by L (Φ drops by at most 4 c L) and the
+///   Euclidean part of the heuristic by at most the base's move, ≤ L + res/√2 (the snap
+///   to the cell); it costs at least `f · k10 · L` (C_B ≥ 1, eq. 3) and L ≥ res, so
+///   `4 c ≤ f · k10 − 1 − 1/√2` suffices;
+/// - a step changes one offset by L and costs at least `f · k7 · L` beyond what the step
+///   bound uses when the bound keeps only `(1 − λ) · k7`: `c ≤ λ · f · k7`;
+/// - drives and turns keep the neutral footprint (Φ = 0).
+///
+/// Returns `(c, λ)` with λ the smallest share of k7 that pays for c (c = 0 when the
+/// constants leave no room). `min_foot_cost` is the smallest finite C_F of the map.
+pub fn offset_potential(params: &StepBoundParams, min_foot_cost: f64) -> (f64, f64) {
+    let f = params.step_cost_factor;
+    let c = (f * params.k11 * min_foot_cost)
+        .min((f * params.k10 - 1.0 - std::f64::consts::FRAC_1_SQRT_2) / 4.0)
+        .min(f * params.k7);
+    if !(c.is_finite() && c > 0.0) {
+        return (0.0, 0.0);
+    }
+    // c ≤ f · k7 here, so λ ≤ 1.
+    (c, (c / (f * params.k7)).min(1.0))
 }

@@ -886,6 +886,8 @@ fn build_step_bound(
         k9: config.k9,
         max_step_height_m: config.max_step_height_m,
         link_cells,
+        k10: config.k10,
+        k11: config.k11,
     };
     let thetas: Vec<u8> = match goal.theta {
         Some(t) => vec![t],
@@ -967,6 +969,7 @@ impl SearchGraph for HybridGraph<'_> {
         };
         let feet = self.feet_pos(s, &o);
         h.saturating_add(self.step_bound.lower_bound(self.maps, &feet))
+            .saturating_add(self.step_bound.offset_potential(&o))
     }
 
     fn is_goal(&self, s: LatticeState) -> bool {

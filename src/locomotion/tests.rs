@@ -444,20 +444,34 @@ mod hybrid {
 
     #[test]
     fn step_bound_is_one_platform_step_per_foot() {
-        // Floor and platform top are two foot components 0.2 m apart in height; linked
-        // cells are ≤ 3 cells apart (64 orientations: a turn moves a foot ≤ 2 cells), so
-        // a step between them is at least (4 − √2) cells long: per foot
-        // f · (k7 · L + k9 · 0.2), with C_F = 1 on the flat platform.
+        // Floor and platform top are two foot components 0.2 m apart in height. C_F is
+        // infinite within r_F = 0.12 m of the edge cells (centres 0.9875 and 1.0125), so
+        // the last finite floor cell is centred at 0.8625 and the first platform one at
+        // 1.1375: 11 cells apart, a step at least 11 / 1.0824 − √2 cells long (octile
+        // over Euclidean distance, feet within half a cell diagonal of their centres).
+        // The offset potential takes c = (f · k10 − 1 − 1/√2) / 4 per metre of offset,
+        // paid by the share λ = c / (f · k7) of eq. 5's k7 term. Per foot
+        // f · ((1 − λ) · k7 · L + k9 · 0.2), with C_F = 1 on the flat platform.
         let maps = platform_maps(0.2);
         let goal = LatticeState::new(120, 40, 0);
         let g = graph(&maps, goal);
         assert!(g.step_bound_components() >= 2, "{}", g.step_bound_components());
         let p = Params::default();
-        let l = (4.0 - std::f64::consts::SQRT_2) * 0.025;
+        let f = p.step_cost_factor;
+        let octile = (1.0 + (std::f64::consts::SQRT_2 - 1.0).powi(2)).sqrt();
+        let l = (11.0 / octile - std::f64::consts::SQRT_2) * 0.025 * (1.0 - 1e-9);
+        let c = (f * p.k10 - 1.0 - std::f64::consts::FRAC_1_SQRT_2) / 4.0;
+        let lambda = c / (f * p.k7);
         let per_foot =
-            Cost::from_f64_floor(p.step_cost_factor * (p.k7 * l + p.k9 * 0.2) * (1.0 - 1e-9));
+            Cost::from_f64_floor(f * ((1.0 - lambda) * p.k7 * l + p.k9 * 0.2) * (1.0 - 1e-9));
+        assert!((per_foot.to_f64() - 5.7845).abs() < 1e-3, "{per_foot}");
         let s = state_at(&g, 0.0, 0.0);
         assert_eq!(g.heuristic(s), driving_heuristic(&g, s).saturating_add(Cost(4 * per_foot.0)));
+        // Offsets (cells) add c · Σ|o|: 6 cells here (all feet stay on the floor).
+        let mut g = g;
+        let t = g.with_offsets(s, [4, 0, -2, 0]).expect("interned");
+        let phi = Cost::from_f64_floor(c * 6.0 * 0.025 * (1.0 - 1e-9));
+        assert_eq!(g.heuristic(t), g.heuristic(s).saturating_add(phi));
         // On the platform, with the goal there: no step left, plain driving heuristic.
         let on = state_at(&g, 2.2, 0.0);
         assert_eq!(g.heuristic(on), driving_heuristic(&g, on));
