@@ -40,10 +40,18 @@
 //!   a finite one after it); between different components the cell centres are more
 //!   than R cells apart along some axis, so `|c_b − c_a| ≥ (R + 1) · res` and, with both
 //!   foot positions within half a cell diagonal of their cell centres,
-//!   `L ≥ (R + 1 − √2) · res`;
+//!   `L ≥ (R + 1 − √2) · res`. On maps of at most [`MAX_DISTANCE_TRANSFORMS`]
+//!   components a tighter bound replaces it: the octile distance transform of each
+//!   component B gives the octile distance d from every cell to B, at most 1.0824 times
+//!   the Euclidean one, so a step from a near cell of A to B is at least
+//!   `min_a d / 1.0824 − √2` cells long (≈ 0.22 m between a floor and a 0.2 m platform,
+//!   whose untraversable band is 2 r_F wide);
 //! - a step starts only from a foot within `step_obstacle_distance_m` of an infinite
 //!   cell (criterion 1), so only components holding a cell of the graph's conservative
 //!   "near an obstacle" layer have outgoing step edges.
+//!
+//! Of the k7 term only the share `1 − λ` enters `w`: the share λ pays for the
+//! foot-offset potential of the hybrid heuristic ([`offset_potential`]).
 //!
 //! The component graph with these edge weights `w(A, B)` (B = A included) is searched
 //! backwards from the component of each goal foot (Dijkstra, dense, O(K²) for K
@@ -63,6 +71,17 @@
 //! Maps with more than [`MAX_COMPONENTS`] components get no step bound (the bound is
 //! then zero everywhere, which is trivially consistent): the O(K²) search would cost
 //! more than it saves.
+//!
+//! **What the bound leaves out, and why.** Most of a platform plan's cost beyond the
+//! steps is driving with a foot close to an edge (C_F in the hundreds, eq. 1). A
+//! per-foot "rolling" bound (κ · C_F per metre a foot rolls, κ = k5 + k4/4 from eq. 4)
+//! would cover it for drives, turns and foot moves, but not for base shifts: a base
+//! shift snaps the base to the cell holding its exact end, so all four feet jump up to
+//! half a cell diagonal, repeatedly, for as little as `f · k10 · res` (one cell, C_B = 1).
+//! Consistency then caps the rolling weight at C_F ≈ 5, and base shifts are possible
+//! wherever a foot can come close to any obstacle (walls included), i.e. almost
+//! everywhere. The same cap (≈ 3.7 per metre) limits a per-cell bound on base motion
+//! taken from the driving pose costs. Neither is worth its set-up time.
 
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::planner::Cost;
@@ -291,7 +310,7 @@ impl StepLengths {
     }
 }
 
-/// Largest number of components for which [`min_step_lengths`] runs a distance transform
+/// Largest number of components for which `min_step_lengths` runs a distance transform
 /// per component (each is two passes over the map).
 pub const MAX_DISTANCE_TRANSFORMS: usize = 32;
 

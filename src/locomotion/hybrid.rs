@@ -49,10 +49,27 @@
 //!   same issue). The edge cost is `max(C_BS · factor, distance moved)`, which keeps the
 //!   heuristic consistent even for factors below 2.
 //!
-//! **Heuristic**: that of [`DrivingGraph`] — Euclidean distance plus the orientation
-//! difference times the turning radius. Steps and foot moves leave the base in place and
-//! cost ≥ 0; drives and base shifts cost at least the distance they move the base; so it
-//! stays consistent (and admissible).
+//! **Heuristic** (issue 4), a sum of three parts, each consistent on every manoeuvre:
+//!
+//! 1. that of [`DrivingGraph`]: Euclidean distance plus the orientation difference times
+//!    the turning radius. Steps and foot moves leave the base in place; drives and base
+//!    shifts cost at least the distance they move the base (pose costs ≥ 1, k_Δθ ≥ 1,
+//!    and a base shift's cost is at least its move); turns cost at least their arc;
+//! 2. the step bound Σ_k S_k of the `heuristic` module: per foot, the cheapest chain of
+//!    steps (C_S, eq. 5, times the step-related factor) from the foot's component of
+//!    finite-C_F cells to the component of its goal position. Only a step moves a foot
+//!    between components, and it costs at least the bound's drop;
+//! 3. the foot-offset potential c · Σ_k |o_k| (offsets in metres; zero for the neutral
+//!    footprint): every offset must be undone before the neutral goal, and each
+//!    manoeuvre that changes offsets pays c per metre — foot moves by eq. 6 (C_F ≥ the
+//!    map's smallest), base shifts by C_BS ≥ f · k10 · L (C_B ≥ 1, eq. 3) with room
+//!    left for part 1, steps by the share λ of eq. 5's k7 term that part 2 leaves out
+//!    (`heuristic::offset_potential`).
+//!
+//! Part 2 is zero where no step is needed and part 3 for the neutral footprint, so a
+//! driving state on flat ground gets part 1 alone, as before. The
+//! proofs are in the `heuristic` module docs; `locomotion::tests` checks
+//! `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge.
 
 use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, edge_cost};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
