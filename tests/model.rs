@@ -159,6 +159,9 @@ fn reference_description_for_unit_tests_equals_the_model() {
         (got.body_com[0], reference.body_com[0]),
         (got.body_com[1], reference.body_com[1]),
         (got.body_com[2], reference.body_com[2]),
+        (got.leg_segment_masses[0], reference.leg_segment_masses[0]),
+        (got.leg_segment_masses[1], reference.leg_segment_masses[1]),
+        (got.leg_segment_masses[2], reference.leg_segment_masses[2]),
     ] {
         assert!(close(a, b), "{a} vs {b}: update RobotDescription::reference()");
     }
@@ -167,4 +170,34 @@ fn reference_description_for_unit_tests_equals_the_model() {
         assert!(close(got.joint_ranges[k].min, reference.joint_ranges[k].min));
         assert!(close(got.joint_ranges[k].max, reference.joint_ranges[k].max));
     }
+}
+
+#[test]
+fn planner_com_estimate_equals_mujocos_in_the_horizontal() {
+    // The planner's lumped CoM (motion::standing::com_estimate) against MuJoCo's for
+    // standing postures like those of a rear step up: pitched base, a rear foot stretched
+    // back, front feet forward. Thigh and shin are symmetric about their midpoints and the
+    // foot hangs vertically under the ankle, so the horizontal CoM is exact.
+    use momaro::motion::kinematics::{Posture, solve_legs};
+    use momaro::motion::standing::com_estimate;
+    let mut sim = Simulation::robot_only(&common::model()).expect("model compiles");
+    let robot = sim.robot().clone();
+    let mut checked = 0;
+    for (pitch, rear_dx, front_dx) in
+        [(0.0, 0.0, 0.0), (-0.12, -0.3, 0.1), (-0.2, -0.1, 0.3), (0.1, 0.2, -0.2)]
+    {
+        let base = [1.0, 0.5, 0.55];
+        let mut feet = robot.hips.map(|h| [base[0] + h[0], base[1] + h[1], 0.0]);
+        feet[2][0] += rear_dx;
+        feet[0][0] += front_dx;
+        let p =
+            Posture { base_position: base, base_rpy: [0.0, pitch, 0.0], feet, contact: [true; 4] };
+        let q = solve_legs(&robot, &p, 0.0).expect("reachable");
+        let truth = sim.com_of_configuration(base, p.base_rpy, &q);
+        let est = com_estimate(&robot, &p).expect("reachable");
+        let err = (est[0] - truth[0]).hypot(est[1] - truth[1]);
+        assert!(err < 1e-6, "pitch {pitch}: estimate {est:?}, MuJoCo {truth:?}");
+        checked += 1;
+    }
+    assert_eq!(checked, 4);
 }

@@ -407,6 +407,7 @@ mod tests {
             total_mass: 50.0,
             body_mass: 30.0,
             body_com: [0.0, 0.0, 0.2],
+            leg_segment_masses: [2.0, 1.5, 1.5],
         }
     }
 

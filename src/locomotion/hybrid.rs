@@ -526,14 +526,21 @@ impl<'c> HybridGraph<'c> {
     /// Whether the step of leg `leg` from feet `feet` (state `s`) to the foot at
     /// `post` (x, y, ground z) stays within reach while the foot is carried (the
     /// standing rule's [`StandingRule::step_heights`]).
-    fn step_in_reach(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
+    /// Returns the first (tallest) such leg height.
+    fn step_in_reach(
+        &self,
+        s: LatticeState,
+        feet: &Feet,
+        leg: usize,
+        post: [f64; 3],
+    ) -> Option<f64> {
         let pose = self.lattice.pose(s);
         let pre = Self::feet_xyz(feet);
         let rule = &self.config.standing;
         let swing = rule.swing_z(&self.robot, self.maps.heights(), pre[leg], post);
-        !rule
-            .step_heights(&self.robot, pre, leg, post, [pose.x, pose.y], pose.theta, swing)
-            .is_empty()
+        rule.step_heights(&self.robot, pre, leg, post, [pose.x, pose.y], pose.theta, swing)
+            .first()
+            .copied()
     }
 
     /// Whether state `t` (footprint offsets `o`) may be entered; its body cost for
@@ -629,10 +636,9 @@ impl<'c> HybridGraph<'c> {
         candidates.into_iter().find_map(|(_, d, cost, foothold)| {
             let mut o2 = *o;
             o2[leg] = (i32::from(o[leg]) + d) as i8;
-            (self.step_supported(s, feet, leg, foothold)
-                && self.target_ok(s, &o2)
-                && self.step_in_reach(s, feet, leg, foothold))
-            .then_some((o2, cost))
+            let height = self.step_in_reach(s, feet, leg, foothold)?;
+            (self.step_supported(s, feet, leg, foothold, height) && self.target_ok(s, &o2))
+                .then_some((o2, cost))
         })
     }
 
@@ -812,14 +818,22 @@ impl<'c> HybridGraph<'c> {
         }
     }
 
-    /// Whether the CoM estimate of state `s` standing by the rule
-    /// ([`com_estimate`]) lies in the support triangle of a step of
+    /// Whether the CoM estimate ([`com_estimate`]) of state `s` standing for the step at
+    /// leg height `height` ([`StandingRule::step_posture`]) lies in the support triangle
+    /// of a step of
     /// `leg` to `post` (x, y) with at least `step_support_margin_m`: the triangle of the
     /// other three feet, the partner on the stepping side driven toward the centre as far
     /// as the generator may (`max_wheel_to_centre_m`, keeping `wheel_gap_m` to the
     /// stepping foot at both ends, stopping before untraversable cells and height
     /// changes), as in Sec. VI-A. Roll and a base shift align the rest.
-    fn step_supported(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
+    fn step_supported(
+        &self,
+        s: LatticeState,
+        feet: &Feet,
+        leg: usize,
+        post: [f64; 3],
+        height: f64,
+    ) -> bool {
         let p = self.lattice.pose(s);
         let (hx, hy) = self.heading(s.theta);
         let along = |q: [f64; 2]| (q[0] - p.x) * hx + (q[1] - p.y) * hy;
@@ -852,12 +866,11 @@ impl<'c> HybridGraph<'c> {
             .filter(|&k| k != leg)
             .map(|k| if k == partner { moved } else { feet.pos[k] })
             .collect();
-        let Ok((stance, _)) =
-            c.standing.stand(&self.robot, Self::feet_xyz(feet), [p.x, p.y], p.theta)
-        else {
-            return false;
-        };
-        stability_margin(&support, com_estimate(&self.robot, &stance)) >= c.step_support_margin_m
+        let pre = Self::feet_xyz(feet);
+        let stance =
+            c.standing.step_posture(&self.robot, pre, leg, post, [p.x, p.y], p.theta, height);
+        com_estimate(&self.robot, &stance)
+            .is_ok_and(|com| stability_margin(&support, com) >= c.step_support_margin_m)
     }
 
     /// Whether the robot can stand by the rule with its base `l` cells ahead of state

@@ -36,12 +36,15 @@
 //! [`CenterOfMassModel`]; its margin in the support polygon of the feet in contact must be
 //! at least [`MotionOptions::min_margin_m`] (default 3 cm).
 //!
-//! **Alternatives before failing**: a step is tried with the manoeuvre leg height 0.45 m,
-//! then lower in 2.5 cm steps down to the driving height, then 0.50 and 0.55 m; for each, full wheel-to-centre alignment, half, none
-//! (a base shift takes what the wheel leaves: all of it, half, none), and full, half, then
-//! no roll. The first candidate
-//! whose every point holds is taken; otherwise [`MotionError::Step`] names the step, the leg
-//! and the best margin reached.
+//! **Alternatives before failing**: a step is tried at the leg heights of the shared
+//! standing rule at which it stays within reach (`StandingRule::step_heights`, the same
+//! check the planner made), tallest first, then at 0.50 and 0.55 m; for each, full
+//! wheel-to-centre alignment, half, none, and as far as the wheel may go (what the
+//! planner's support check assumed); full, half, then no roll; a base shift taking what
+//! the wheel leaves (all, half, none). Then, as a second pass, fixed base shifts of
+//! ±2.5 to ±20 cm with every wheel and roll choice. The first candidate whose every point
+//! holds is taken; otherwise [`MotionError::Step`] names the step, the leg and the best
+//! margin reached.
 
 use super::CenterOfMassModel;
 use super::keyframe::{DetailedPath, Keyframe, Phase};
@@ -461,7 +464,15 @@ impl Expander<'_> {
         } else {
             along(pre[j]) - (along(pre[i]).max(along(post_foot)) + o.wheel_gap_m)
         };
-        let target = (wanted * wheel_fraction).min(gap_limit.max(0.0));
+        // `wheel_fraction` of the aligning move, or (infinite) as far as allowed: the
+        // planner's support check assumes that much (a diagonal support edge may need the
+        // wheel further in than longitudinal alignment asks).
+        let target = if wheel_fraction.is_infinite() {
+            o.max_wheel_to_centre_m
+        } else {
+            wanted * wheel_fraction
+        }
+        .min(gap_limit.max(0.0));
         let mut d = 0.0;
         let step = 0.01;
         while d + step <= target + 1e-9 {
@@ -582,14 +593,15 @@ impl Expander<'_> {
         let mut candidates = Vec::new();
         for pass in 0..2 {
             for &h in &heights {
-                for wf in [1.0, 0.5, 0.0] {
+                for wf in [1.0, 0.5, 0.0, f64::INFINITY] {
                     for rf in [1.0, 0.5, 0.0] {
                         if pass == 0 {
                             for f in [1.0, 0.5, 0.0] {
                                 candidates.push((h, wf, rf, Shift::Remainder(f)));
                             }
                         } else {
-                            for m in [0.025, 0.05, 0.1, 0.15, 0.2, -0.025, -0.05, -0.1, -0.15, -0.2] {
+                            for m in [0.025, 0.05, 0.1, 0.15, 0.2, -0.025, -0.05, -0.1, -0.15, -0.2]
+                            {
                                 candidates.push((h, wf, rf, Shift::Fixed(m)));
                             }
                         }

@@ -167,6 +167,29 @@ impl StandingRule {
     }
 }
 
+impl StandingRule {
+    /// The posture at the start of a step of leg `leg` from feet `pre` to `post_foot`
+    /// at leg height `height`: all feet still down, the step's pitch, the stepping leg
+    /// counting the higher ground (as [`Self::step_heights`] checks it).
+    pub fn step_posture(
+        &self,
+        robot: &RobotDescription,
+        pre: [[f64; 3]; 4],
+        leg: usize,
+        post_foot: [f64; 3],
+        xy: [f64; 2],
+        yaw: f64,
+        height: f64,
+    ) -> Posture {
+        let mut post = pre;
+        post[leg] = post_foot;
+        let pitch = self.step_pitch(&pre, &post, yaw);
+        let mut ground = pre.map(|f| f[2]);
+        ground[leg] = pre[leg][2].max(post_foot[2]);
+        level_posture(robot, pre, [true; 4], xy, [0.0, pitch, yaw], height, ground)
+    }
+}
+
 /// Spacing of the swing points [`StandingRule::step_heights`] checks, m.
 const SWING_SAMPLE_M: f64 = 0.05;
 
@@ -236,24 +259,45 @@ impl ReachProbe {
 }
 
 /// Horizontal CoM estimate of posture `p` for the planner, which has no MuJoCo: the base
-/// body (everything but the legs) at its own CoM, each leg's share of the rest of the mass
-/// at the middle of its hip and its foot. It catches what the base centre misses: the
-/// upper body leaning back with a pitched base, and legs stretched behind.
-pub fn com_estimate(robot: &RobotDescription, p: &Posture) -> [f64; 2] {
+/// body (everything but the legs) at its own CoM; per leg the thigh and shin at their
+/// midpoints (joint angles from the sagittal IK) and the foot with steering and wheels at
+/// the foot. Masses and CoM come from the model. With symmetric segments and the foot
+/// hanging vertically (wheel level) this is MuJoCo's CoM in the horizontal plane
+/// (`tests/model.rs` checks it to 1 µm). It sees what the base centre misses: the upper
+/// body leaning back with a pitched base, and heavy feet stretched behind.
+///
+/// # Errors
+/// [`PostureError`] if a leg cannot reach its foot.
+pub fn com_estimate(robot: &RobotDescription, p: &Posture) -> Result<[f64; 2], PostureError> {
+    let joints = solve_legs(robot, p, 0.0)?;
     let r = rotation(p.base_rpy);
-    let body = apply(&r, p.base_position, robot.body_com);
-    let hips = super::kinematics::hips_in_world(robot, p);
-    let leg_mass = ((robot.total_mass - robot.body_mass) / 4.0).max(0.0);
-    let total = robot.body_mass + 4.0 * leg_mass;
-    if total <= 0.0 {
-        return [p.base_position[0], p.base_position[1]];
-    }
+    let world = |b: [f64; 3]| apply(&r, p.base_position, b);
+    let body = world(robot.body_com);
+    let [m_thigh, m_shin, m_foot] = robot.leg_segment_masses;
     let mut c = [robot.body_mass * body[0], robot.body_mass * body[1]];
-    for (h, f) in hips.iter().zip(&p.feet) {
-        c[0] += leg_mass * (h[0] + f[0]) / 2.0;
-        c[1] += leg_mass * (h[1] + f[1]) / 2.0;
+    let mut total = robot.body_mass;
+    for (i, q) in joints.iter().enumerate() {
+        let h = robot.hips[i];
+        // Sagittal chain in the base frame: a segment at angle a from straight down.
+        let knee = [h[0] - robot.thigh_length * q[0].sin(), h[2] - robot.thigh_length * q[0].cos()];
+        let a = q[0] + q[1];
+        let ankle = [knee[0] - robot.shin_length * a.sin(), knee[1] - robot.shin_length * a.cos()];
+        let thigh = world([(h[0] + knee[0]) / 2.0, h[1], (h[2] + knee[1]) / 2.0]);
+        let shin = world([(knee[0] + ankle[0]) / 2.0, h[1], (knee[1] + ankle[1]) / 2.0]);
+        for (m, x, y) in [
+            (m_thigh, thigh[0], thigh[1]),
+            (m_shin, shin[0], shin[1]),
+            (m_foot, p.feet[i][0], p.feet[i][1]),
+        ] {
+            c[0] += m * x;
+            c[1] += m * y;
+            total += m;
+        }
     }
-    [c[0] / total, c[1] / total]
+    if total <= 0.0 {
+        return Ok([p.base_position[0], p.base_position[1]]);
+    }
+    Ok([c[0] / total, c[1] / total])
 }
 
 /// Base origin height for the base at `rpy` such that the hip over the highest of `ground`
@@ -421,25 +465,23 @@ mod tests {
     }
 
     #[test]
-    fn com_estimate_by_hand() {
-        // Level base at the origin, feet under the hips: 34 kg at (0.04/34, 0), four 6 kg
-        // legs symmetric about the origin, so the CoM is at x = 0.04 / 58.
+    fn com_estimate_matches_mujoco_lumped_by_hand() {
+        // Level base, feet under the hips 0.45 m down: every leg's chain is symmetric
+        // front to rear (knees toward the centre), so only the body's x' = 0.04/34 and
+        // the legs' mirror images remain: CoM x = 34 · (0.04/34) / 58.
         let robot = RobotDescription::reference();
-        let feet = robot.hips.map(|h| [h[0], h[1], -0.4]);
+        let feet = robot.hips.map(|h| [h[0], h[1], h[2] - 0.45]);
         let p = Posture { base_position: [0.0; 3], base_rpy: [0.0; 3], feet, contact: [true; 4] };
-        let c = com_estimate(&robot, &p);
-        assert!((c[0] - 0.04 / 58.0).abs() < 1e-12 && c[1].abs() < 1e-12);
-        // Nose up by 0.1 rad: the body CoM (z' = 6.36/34) leans back by z'·sin 0.1; each
-        // hip (z' = −0.05) moves forward by 0.05·sin 0.1, and the front and rear hips'
-        // ±0.35·cos 0.1 cancel, so the four leg midpoints add 4 · 0.05·sin 0.1 / 2.
-        let p = Posture { base_rpy: [0.0, -0.1, 0.0], ..p };
-        let c = com_estimate(&robot, &p);
-        let body_x = 0.04 / 34.0 * 0.1f64.cos() - 6.36 / 34.0 * 0.1f64.sin();
-        let legs_x = 6.0 * 2.0 * 0.05 * 0.1f64.sin();
-        assert!((c[0] - (34.0 * body_x + legs_x) / 58.0).abs() < 1e-12, "{c:?}");
-        // A rear foot stretched 0.4 m back moves 6 kg's midpoint by 0.2 m.
+        let c = com_estimate(&robot, &p).unwrap();
+        assert!((c[0] - 0.04 / 58.0).abs() < 1e-12 && c[1].abs() < 1e-12, "{c:?}");
+        // A rear foot 0.2 m further back moves its 2.7 kg foot by 0.2 m, and its thigh and
+        // shin somewhere between: the CoM moves back by more than 2.7 · 0.2 / 58.
         let mut q = p;
-        q.feet[2][0] -= 0.4;
-        assert!((com_estimate(&robot, &q)[0] - (c[0] - 6.0 * 0.2 / 58.0)).abs() < 1e-12);
+        q.feet[2][0] -= 0.2;
+        let back = c[0] - com_estimate(&robot, &q).unwrap()[0];
+        assert!(back > 2.7 * 0.2 / 58.0 && back < 6.0 * 0.2 / 58.0, "{back}");
+        // Out of reach: an error, not a guess.
+        q.feet[2][0] -= 1.0;
+        assert!(com_estimate(&robot, &q).is_err());
     }
 }

@@ -108,6 +108,8 @@ pub struct RobotDescription {
     pub body_mass: f64,
     /// The base body's own CoM in the base frame, m.
     pub body_com: [f64; 3],
+    /// Per leg: thigh, shin, and foot with steering and wheels (the foot's subtree), kg.
+    pub leg_segment_masses: [f64; 3],
 }
 
 impl RobotDescription {
@@ -136,6 +138,7 @@ impl RobotDescription {
             // Base box 15 kg at 0, torso 17 kg at z' = 0.30, head 2 kg at (0.02, 0, 0.63).
             body_mass: 34.0,
             body_com: [0.04 / 34.0, 0.0, 6.36 / 34.0],
+            leg_segment_masses: [1.8, 1.5, 2.7],
         }
     }
 

@@ -100,6 +100,13 @@ pub(crate) fn describe(model: &MjModel) -> Result<RobotDescription, SimError> {
     let offsets = &model.numeric_data()[adr..adr + 4];
     let neutral_foot_offset_x = [offsets[0], offsets[1], offsets[2], offsets[3]];
 
+    // Front-left leg's masses: thigh, shin, and the foot with steering and wheels.
+    let fl = LegNames::of(Leg::FrontLeft);
+    let leg_segment_masses = [
+        model.body_mass()[id(model, MjtObjBase::mjOBJ_BODY, &fl.thigh)?],
+        model.body_mass()[id(model, MjtObjBase::mjOBJ_BODY, &fl.shin)?],
+        model.body_subtreemass()[id(model, MjtObjBase::mjOBJ_BODY, &fl.foot)?],
+    ];
     let base = id(model, MjtObjBase::mjOBJ_BODY, "base")?;
     let base_box = id(model, MjtObjBase::mjOBJ_GEOM, "base_box")?;
     let base_half_extents = model.geom_size()[base_box];
@@ -120,6 +127,7 @@ pub(crate) fn describe(model: &MjModel) -> Result<RobotDescription, SimError> {
         total_mass: model.body_subtreemass()[base],
         body_mass: model.body_mass()[base],
         body_com: model.body_ipos()[base],
+        leg_segment_masses,
     })
 }
 
