@@ -7,9 +7,11 @@
 
 mod common;
 
+use momaro::control::step_executor::ExecEventKind;
 use momaro::jobs::plan::{self, PathKind, PlanOptions, PlanSummary};
 use momaro::jobs::run::{self, Mission, Push, RunOptions, RunSummary};
 use momaro::motion::{DetailedPath, Phase};
+use momaro::robot::Leg;
 use momaro::scenario::Scenario;
 use momaro::sim::Simulation;
 use std::time::Instant;
@@ -96,4 +98,52 @@ fn platform_prefix_front_feet_climb_onto_the_platform() {
     assert!(s.min_stability_margin_m >= 0.02, "{}", s.min_stability_margin_m);
     assert!(!s.tipped, "{:?}", s.events);
     assert!(s.body_collisions.is_empty(), "{:?}", s.body_collisions);
+}
+
+#[test]
+fn lateral_push_on_three_legs_puts_the_foot_down_and_the_step_is_retried() {
+    // Step 2 of the platform prefix is the front-left step up, the one with the smallest
+    // margin (4–7 cm on three legs): 1 s into its swing, the base is pushed to the left,
+    // toward the lifted foot, with 100 N for 0.3 s. The robot is stiff, so the static
+    // margin hardly changes until the push lifts a support wheel (right rear): then the
+    // measured support shrinks and the margin falls below zero. The executor must see it,
+    // put the foot down at once, and retry the step once the margin is back.
+    let sc = common::scenario("platform");
+    let push = Push {
+        step: 2,
+        phase: Phase::Swing,
+        delay_s: 1.0,
+        force: [0.0, 100.0, 0.0],
+        duration_s: 0.3,
+    };
+    let s = execute_prefix(&sc, Some(push));
+    let r = s.push.expect("the push was applied");
+    println!("push: {r:?}, max tilt {:.1}°", s.max_tilt_deg);
+    // The monitor saw the margin fall (by more than 5 cm, below zero).
+    assert!(
+        r.min_margin_after_m < r.margin_before_m - 0.05 && r.min_margin_after_m < 0.0,
+        "margin {:.3} → {:.3} m",
+        r.margin_before_m,
+        r.min_margin_after_m
+    );
+    // The executor put the foot down within 0.2 s of the push start …
+    let put_down = s
+        .executor_events
+        .iter()
+        .find_map(|e| match e.event {
+            ExecEventKind::FootPutDown { leg, .. } => Some((e.time_s, leg)),
+            _ => None,
+        })
+        .expect("the foot was put down");
+    assert_eq!(put_down.1, Leg::FrontLeft);
+    assert!(put_down.0 >= r.start_s && put_down.0 <= r.start_s + 0.2, "{put_down:?} {r:?}");
+    // … the support wheel came back within 0.6 s and the robot stayed upright …
+    assert!(r.negative_margin_s <= 0.6, "{r:?}");
+    assert!(r.max_tilt_deg < 10.0, "{r:?}");
+    assert!(s.max_tilt_deg < 15.0, "{}", s.max_tilt_deg);
+    assert!(s.body_collisions.is_empty(), "{:?}", s.body_collisions);
+    // … and the retried step and the rest were executed.
+    assert!(s.failure.is_none(), "{:?}", s.failure);
+    assert_eq!(s.steps_executed, s.steps_planned);
+    assert_eq!(s.steps_aborted, 0);
 }

@@ -120,7 +120,7 @@ impl ExecutorConfig {
             slowest_rate: 0.2,
             settle_tolerance_rad: 0.03,
             max_settle_s: 1.5,
-            put_down_speed_mps: 0.1,
+            put_down_speed_mps: 0.25,
             recover_speed_mps: 0.1,
             recover_angular_speed: 0.2,
             driving_leg_height_m: params.driving_leg_height_m,

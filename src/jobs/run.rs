@@ -149,6 +149,10 @@ pub struct PushReport {
     pub margin_before_m: f64,
     /// Smallest measured margin from the push start until 2 s after its end, m.
     pub min_margin_after_m: f64,
+    /// Time the measured margin was negative in that window, s.
+    pub negative_margin_s: f64,
+    /// Largest |roll| or |pitch| in that window, degrees.
+    pub max_tilt_deg: f64,
 }
 
 /// The smallest measured margin while one step's foot was off its support (from the lift
@@ -229,6 +233,8 @@ pub struct RunSummary {
     pub mean_tracking_error_m: f64,
     /// Largest |base pitch| seen, degrees.
     pub max_pitch_deg: f64,
+    /// Largest |roll| or |pitch| seen after settling, degrees.
+    pub max_tilt_deg: f64,
     /// The expectations and their results.
     pub expectations: Vec<ExpectationResult>,
     /// Monitor events.
@@ -547,6 +553,8 @@ pub fn execute(
                         start_s: now,
                         margin_before_m: last_margin,
                         min_margin_after_m: last_margin,
+                        negative_margin_s: 0.0,
+                        max_tilt_deg: 0.0,
                     });
                     sim.push_base(p.force);
                 }
@@ -565,6 +573,11 @@ pub fn execute(
             && sim.time() <= r.start_s + p.duration_s + 2.0
         {
             r.min_margin_after_m = r.min_margin_after_m.min(sample.margin);
+            if sample.margin < 0.0 {
+                r.negative_margin_s += control_dt;
+            }
+            let tilt = sample.roll_pitch[0].abs().max(sample.roll_pitch[1].abs());
+            r.max_tilt_deg = r.max_tilt_deg.max(tilt.to_degrees());
         }
         if let Some(a) = exec.active_step() {
             let key = (replans, a.number);
@@ -642,6 +655,7 @@ pub fn execute(
         max_tracking_error_m: max_track,
         mean_tracking_error_m: if n_track > 0 { sum_track / n_track as f64 } else { 0.0 },
         max_pitch_deg: max_pitch.to_degrees(),
+        max_tilt_deg: monitor.max_tilt.to_degrees(),
         expectations: Vec::new(),
         events: monitor.events.clone(),
     };
