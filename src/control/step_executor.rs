@@ -1074,3 +1074,283 @@ impl StepExecutor {
         (index..self.keys.len()).find(|&j| self.keys[j].phase == Phase::Place).unwrap_or(index)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::motion::kinematics::{contacts_in_base, leg_joint_targets};
+    use crate::robot::ik::leg_fk;
+
+    fn robot() -> RobotDescription {
+        RobotDescription::reference()
+    }
+
+    /// Level base 0.5 m up at the origin, feet under the hips on flat ground.
+    fn standing() -> Posture {
+        let r = robot();
+        Posture {
+            base_position: [0.0, 0.0, 0.5],
+            base_rpy: [0.0, 0.0, 0.0],
+            feet: std::array::from_fn(|i| [r.hips[i][0], r.hips[i][1], 0.0]),
+            contact: [true; 4],
+        }
+    }
+
+    fn key(time_s: f64, phase: Phase, leg: Option<Leg>, p: &Posture) -> Keyframe {
+        Keyframe {
+            time_s,
+            phase,
+            path_index: 0,
+            leg,
+            base_position: p.base_position,
+            base_rpy: p.base_rpy,
+            feet: p.feet,
+            contact: p.contact,
+            leg_heights: [0.45; 4],
+            joints: leg_joint_targets(&robot(), p).unwrap(),
+            com: [0.0; 3],
+            margin_m: 0.1,
+            segment_min_margin_m: 0.1,
+            centroid_distance_m: 0.0,
+        }
+    }
+
+    #[test]
+    fn smoothstep_by_hand() {
+        assert_eq!(smoothstep(0.0), 0.0);
+        assert_eq!(smoothstep(1.0), 1.0);
+        assert!((smoothstep(0.5) - 0.5).abs() < 1e-12);
+        // 3·0.25² − 2·0.25³ = 0.1875 − 0.03125.
+        assert!((smoothstep(0.25) - 0.15625).abs() < 1e-12);
+        assert_eq!(smoothstep(2.0), 1.0);
+        // 6·0.5·0.5 = 1.5 at the middle, zero at the ends.
+        assert!((smoothstep_rate(0.5) - 1.5).abs() < 1e-12);
+        assert_eq!(smoothstep_rate(0.0), 0.0);
+        assert_eq!(smoothstep_rate(1.0), 0.0);
+    }
+
+    #[test]
+    fn wheel_speed_is_the_foot_speed_along_the_heading_over_the_radius() {
+        // r = 0.08 m: 0.1 m/s straight ahead is 1.25 rad/s; heading 90° sees only v_y.
+        let r = robot();
+        assert!((rolling_wheel_speed(&r, [0.1, 0.0], 0.0) - 1.25).abs() < 1e-12);
+        assert!((rolling_wheel_speed(&r, [0.1, 0.0], std::f64::consts::FRAC_PI_2)).abs() < 1e-12);
+        assert!(
+            (rolling_wheel_speed(&r, [0.0, -0.04], std::f64::consts::FRAC_PI_2) + 0.5).abs()
+                < 1e-12
+        );
+        // 60°: 0.1·cos 60° = 0.05 m/s → 0.625 rad/s.
+        assert!(
+            (rolling_wheel_speed(&r, [0.1, 0.0], std::f64::consts::FRAC_PI_3) - 0.625).abs()
+                < 1e-12
+        );
+    }
+
+    #[test]
+    fn clock_slows_linearly_between_the_error_bounds() {
+        assert_eq!(clock_rate(0.01, 0.05, 0.2, 0.2), 1.0);
+        // Half-way (0.125 rad): 1 − 0.8·0.5 = 0.6.
+        assert!((clock_rate(0.125, 0.05, 0.2, 0.2) - 0.6).abs() < 1e-12);
+        assert_eq!(clock_rate(0.5, 0.05, 0.2, 0.2), 0.2);
+    }
+
+    #[test]
+    fn motion_duration_takes_the_slowest_part() {
+        let a = standing();
+        let mut b = a;
+        b.feet[0][0] += 0.3; // 3 s at 0.1 m/s
+        b.base_rpy[0] = 0.1; // 0.5 s at 0.2 rad/s
+        assert!((motion_duration(&a, &b, 0.1, 0.2) - 3.0).abs() < 1e-12);
+        assert!((motion_duration(&a, &a, 0.1, 0.2) - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn landing_offset_undoes_the_drift() {
+        // Pure translation: the robot stands 2 cm ahead and 1 cm left of its command; the
+        // foot must be commanded 2 cm behind and 1 cm right of the foothold.
+        let o = landing_offset(Pose2::new(1.0, 0.0, 0.0), Pose2::new(1.02, 0.01, 0.0), [1.4, 0.3]);
+        assert!((o[0] + 0.02).abs() < 1e-12 && (o[1] + 0.01).abs() < 1e-12);
+        // Pure rotation by +0.1 rad about the base: the foothold 0.4 m ahead is commanded
+        // at 0.4·(cos 0.1, −sin 0.1) relative to the base.
+        let o = landing_offset(Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.0, 0.0, 0.1), [0.4, 0.0]);
+        assert!((o[0] - (0.4 * 0.1f64.cos() - 0.4)).abs() < 1e-12);
+        assert!((o[1] + 0.4 * 0.1f64.sin()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_foot_beyond_reach_is_pulled_in_along_the_hip_ankle_line() {
+        let r = robot();
+        let mut p = standing();
+        // Hip 0.45 m above the ground: the ankle (0.18 m above the contact) 0.27 m below
+        // the hip, reachable. Moving the front-left foot 0.45 m forward puts the ankle
+        // √(0.45² + 0.27²) = 0.525 m from the hip, beyond 0.5.
+        p.feet[0][0] += 0.45;
+        assert!(leg_joint_targets(&r, &p).is_err());
+        let q = reachable_leg_targets(&r, &p, 0.001).unwrap();
+        let c = leg_fk(&r, q[0], 0.0);
+        let ankle = [c[0], c[1] + r.foot_length + r.wheel_radius];
+        assert!((ankle[0].hypot(ankle[1]) - 0.499).abs() < 1e-9);
+        // Along the line: the ankle direction is unchanged.
+        let want = 0.45f64.atan2(0.27);
+        assert!((ankle[0].atan2(-ankle[1]) - want).abs() < 1e-9);
+        // Reachable feet are untouched.
+        let local = contacts_in_base(&r, &p);
+        for i in 1..4 {
+            let f = leg_fk(&r, q[i], 0.0);
+            assert!((f[0] - local[i][0]).abs() < 1e-9 && (f[1] - local[i][2]).abs() < 1e-9);
+        }
+    }
+
+    fn obs(
+        time: f64,
+        ex: &StepExecutor,
+        contacts: &[(Leg, [f64; 2])],
+        com: [f64; 3],
+    ) -> Observation {
+        Observation {
+            time,
+            base: Pose2::new(0.0, 0.0, 0.0),
+            joints: ex.last_legs,
+            steering: [0.0; 4],
+            steering_rate: [0.0; 4],
+            com,
+            wheel_contacts: contacts.to_vec(),
+        }
+    }
+
+    fn config() -> ExecutorConfig {
+        ExecutorConfig::from_params(&Params::default(), FollowerConfig::default())
+    }
+
+    /// Start, lift, swing and place of the front-left foot 0.1 m forward on flat ground.
+    fn step_path() -> Vec<Keyframe> {
+        let a = standing();
+        let mut lift = a;
+        lift.feet[0][2] = 0.05;
+        lift.contact[0] = false;
+        let mut swing = lift;
+        swing.feet[0][0] += 0.1;
+        let mut place = swing;
+        place.feet[0][2] = 0.0;
+        place.contact[0] = true;
+        vec![
+            key(0.0, Phase::Start, None, &a),
+            key(0.5, Phase::Lift, Some(Leg::FrontLeft), &lift),
+            key(1.5, Phase::Swing, Some(Leg::FrontLeft), &swing),
+            key(2.0, Phase::Place, Some(Leg::FrontLeft), &place),
+        ]
+    }
+
+    fn all_contacts(feet: &[[f64; 3]; 4]) -> Vec<(Leg, [f64; 2])> {
+        Leg::ALL.iter().map(|&l| (l, [feet[l.index()][0], feet[l.index()][1]])).collect()
+    }
+
+    fn ground() -> HeightMap {
+        HeightMap::filled([-2.0, -2.0], 0.025, 160, 160, 0.0).unwrap()
+    }
+
+    #[test]
+    fn a_step_lifts_after_the_margin_check_and_ends_only_on_contact() {
+        let keys = step_path();
+        let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+        let feet = keys[0].feet;
+        // The CoM 0.14 m inside the FR–RL diagonal (which passes through the origin).
+        let com = [-0.1, -0.1, 0.4];
+        let without_fl: Vec<_> =
+            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        let mut t = 0.0;
+        let mut lifted_at = None;
+        let mut status = ExecStatus::Running;
+        // Until the foot is placed, MuJoCo reports no contact of FL.
+        for _ in 0..1000 {
+            t += 0.01;
+            let (_, st) = ex.tick(&obs(t, &ex, &without_fl, com), 0.01);
+            status = st;
+            if lifted_at.is_none() && ex.active_step().is_some() {
+                lifted_at = Some(t);
+            }
+        }
+        // Lifted after the 0.3 s settle, the step not done without contact, the foot
+        // lowered by the full extra distance (5 cm), then failed.
+        let lifted_at = lifted_at.expect("lifted");
+        assert!((lifted_at - 0.3).abs() < 0.02, "{lifted_at}");
+        assert_eq!(ex.steps_executed, 0);
+        assert_eq!(ex.steps_aborted, 1);
+        assert!(ex.events.iter().any(|e| matches!(
+            e.event,
+            ExecEventKind::Failure { failure: ExecFailure::NoContact { leg: Leg::FrontLeft, .. } }
+        )));
+        assert!(
+            matches!(status, ExecStatus::NeedsReplan(ExecFailure::NoContact { .. })),
+            "{status:?}"
+        );
+
+        // The same with contact reported once the foot is down: the step is executed.
+        let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+        let placed = keys[3].feet;
+        let mut t = 0.0;
+        for _ in 0..1000 {
+            t += 0.01;
+            // FL touches once it is being placed.
+            let down = matches!(ex.phase(), Some(Phase::Place) | None);
+            let c = if down { all_contacts(&placed) } else { without_fl.clone() };
+            let (_, st) = ex.tick(&obs(t, &ex, &c, com), 0.01);
+            if st == ExecStatus::Finished {
+                break;
+            }
+        }
+        assert_eq!(ex.steps_executed, 1, "{:?}", ex.events);
+        assert_eq!(ex.steps_aborted, 0);
+    }
+
+    #[test]
+    fn a_low_margin_is_corrected_toward_the_centroid_then_the_step_is_aborted() {
+        let keys = step_path();
+        let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+        let feet = keys[0].feet;
+        let without_fl: Vec<_> =
+            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        // The CoM 1 cm inside the FR–RL diagonal (x = −y·0.35/0.32 through the origin):
+        // a measured margin of 1 cm, below the 2 cm to lift. It does not move (the
+        // corrections have no effect here), so after three corrections the step is aborted
+        // with the foot never lifted.
+        let n = [0.32f64, 0.35];
+        let len = n[0].hypot(n[1]);
+        let com = [-0.01 * n[0] / len, -0.01 * n[1] / len, 0.4];
+        let o = obs(0.0, &ex, &without_fl, com);
+        assert!((o.support_margin(Leg::FrontLeft) - 0.01).abs() < 1e-9);
+        let mut t = 0.0;
+        let mut status = ExecStatus::Running;
+        for _ in 0..600 {
+            t += 0.01;
+            let (cmd, st) = ex.tick(&obs(t, &ex, &without_fl, com), 0.01);
+            assert!(ex.active_step().is_none(), "lifted at {t}");
+            // Stance wheels held until the abort (then the feet roll back to neutral).
+            if ex.steps_aborted == 0 {
+                assert!(cmd.wheels.iter().all(|w| w.wheel_speeds == [0.0, 0.0]));
+            }
+            status = st;
+        }
+        let corrections: Vec<f64> = ex
+            .events
+            .iter()
+            .filter_map(|e| match e.event {
+                ExecEventKind::Correction { correction_m, .. } => Some(correction_m),
+                _ => None,
+            })
+            .collect();
+        // First increment: (0.02 + 0.01 − 0.01) / 0.8 = 2.5 cm, then 5 cm, then the 6 cm cap.
+        assert_eq!(corrections.len(), 3, "{:?}", ex.events);
+        assert!((corrections[0] - 0.025).abs() < 1e-9, "{corrections:?}");
+        assert!((corrections[1] - 0.05).abs() < 1e-9);
+        assert!((corrections[2] - 0.06).abs() < 1e-9);
+        assert_eq!(ex.steps_aborted, 1);
+        assert!(
+            matches!(
+                status,
+                ExecStatus::NeedsReplan(ExecFailure::StepAborted { leg: Leg::FrontLeft, .. })
+            ),
+            "{status:?}"
+        );
+    }
+}

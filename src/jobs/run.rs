@@ -41,7 +41,7 @@ pub enum RunJobError {
     #[error(transparent)]
     Plan(#[from] PlanJobError),
     /// The plan could not be expanded into keyframes (step motion generation).
-    #[error("{scenario}: step motion generation: {source}")]
+    #[error("{scenario}: step motion generation")]
     Motion {
         /// Scenario name.
         scenario: String,
