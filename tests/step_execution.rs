@@ -20,15 +20,19 @@ fn plan_options() -> PlanOptions {
     PlanOptions { time_limit_s: 60.0, ..PlanOptions::default() }
 }
 
-/// The prefix of the path before the first step of a rear leg onto higher ground.
-fn before_rear_step_up(p: &PlanSummary) -> usize {
+/// The prefix of the path before the `n`-th (0-based) step of a rear leg onto higher
+/// ground.
+fn before_rear_step_up(p: &PlanSummary, n: usize) -> usize {
     p.path
         .iter()
-        .position(|e| {
+        .enumerate()
+        .filter(|(_, e)| {
             e.kind == PathKind::Step
                 && e.leg.is_some_and(|l| !l.is_front())
                 && e.step.is_some_and(|s| s.height_m > 0.05)
         })
+        .map(|(i, _)| i)
+        .nth(n)
         .unwrap_or(p.path.len())
 }
 
@@ -45,12 +49,12 @@ fn without_rear_step_preparation(p: &PlanSummary, end: usize, d: &mut DetailedPa
 
 /// Plans `sc`, expands the prefix before the first rear step up, and executes it without
 /// replanning (a replan would plan the whole path again).
-fn execute_prefix(sc: &Scenario, push: Option<Push>) -> RunSummary {
+fn execute_prefix(sc: &Scenario, rear_steps_up: usize, push: Option<Push>) -> RunSummary {
     let wall = Instant::now();
     let mut sim = Simulation::new(sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
     let plan = plan::run(sc, &robot, &plan_options()).expect("plan");
-    let end = before_rear_step_up(&plan);
+    let end = before_rear_step_up(&plan, rear_steps_up);
     assert!(end < plan.path.len(), "the plan has a rear step up");
     let mut detailed = run::expand_mission(sc, &mut sim, &plan, end).expect("prefix expands");
     without_rear_step_preparation(&plan, end, &mut detailed);
@@ -80,7 +84,7 @@ fn execute_prefix(sc: &Scenario, push: Option<Push>) -> RunSummary {
 #[test]
 fn platform_prefix_front_feet_climb_onto_the_platform() {
     let sc = common::scenario("platform");
-    let s = execute_prefix(&sc, None);
+    let s = execute_prefix(&sc, 0, None);
     assert!(s.failure.is_none(), "{:#?}", s);
     assert!(s.steps_planned >= 2, "front steps up in the prefix: {}", s.steps_planned);
     assert_eq!(s.steps_executed, s.steps_planned, "{:#?}", s.executor_events);
@@ -101,6 +105,24 @@ fn platform_prefix_front_feet_climb_onto_the_platform() {
 }
 
 #[test]
+#[ignore = "fails: the third step (front-left onto the second tread) measures 1.5 cm before \
+            the lift (planned ≥ 3 cm), is corrected to 2.2 cm, lifts, and the margin falls to \
+            −1.3 cm as the foot unloads; the foot is put down, and the retries need 5 cm, \
+            which the 6 cm correction does not reach (4.0 cm): step aborted"]
+fn staircase_prefix_front_steps_and_first_rear_step_up() {
+    let sc = common::scenario("staircase");
+    let s = execute_prefix(&sc, 1, None);
+    assert!(s.failure.is_none(), "{:#?}", s);
+    assert!(s.steps_planned >= 3, "{}", s.steps_planned);
+    assert_eq!(s.steps_executed, s.steps_planned, "{:#?}", s.executor_events);
+    for m in &s.step_margins {
+        assert!(m.min_margin_m >= 0.02, "step {} ({:?}): {:.3} m", m.step, m.leg, m.min_margin_m);
+    }
+    assert!(!s.tipped, "{:?}", s.events);
+    assert!(s.body_collisions.is_empty(), "{:?}", s.body_collisions);
+}
+
+#[test]
 fn lateral_push_on_three_legs_puts_the_foot_down_and_the_step_is_retried() {
     // Step 2 of the platform prefix is the front-left step up, the one with the smallest
     // margin (4–7 cm on three legs): 1 s into its swing, the base is pushed to the left,
@@ -116,7 +138,7 @@ fn lateral_push_on_three_legs_puts_the_foot_down_and_the_step_is_retried() {
         force: [0.0, 100.0, 0.0],
         duration_s: 0.3,
     };
-    let s = execute_prefix(&sc, Some(push));
+    let s = execute_prefix(&sc, 0, Some(push));
     let r = s.push.expect("the push was applied");
     println!("push: {r:?}, max tilt {:.1}°", s.max_tilt_deg);
     // The monitor saw the margin fall (by more than 5 cm, below zero).

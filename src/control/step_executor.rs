@@ -70,6 +70,9 @@ pub struct ExecutorConfig {
     pub max_correction_attempts: usize,
     /// Retries of a step whose foot had to be put down.
     pub max_step_retries: usize,
+    /// Extra margin required to lift per retry of a step, m: the margin lost when the
+    /// foot unloaded last time must be made up by more correction.
+    pub retry_margin_increment_m: f64,
     /// Measured base farther than this from the commanded one (planar) needs a replan, m.
     pub drift_tolerance_m: f64,
     /// Measured heading farther than this from the commanded one needs a replan, rad.
@@ -113,6 +116,7 @@ impl ExecutorConfig {
             correction_time_s: 0.8,
             max_correction_attempts: 3,
             max_step_retries: 2,
+            retry_margin_increment_m: 0.03,
             drift_tolerance_m: 0.15,
             drift_tolerance_rad: 0.25,
             slowdown_start_rad: 0.05,
@@ -904,7 +908,9 @@ impl StepExecutor {
                     return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
                 }
                 let m = obs.support_margin(leg);
-                if m >= c.min_lift_margin_m {
+                let required =
+                    c.min_lift_margin_m + self.retries as f64 * c.retry_margin_increment_m;
+                if m >= required {
                     self.event(time, ExecEventKind::Lift { leg, margin_m: m });
                     if self.retries == 0 {
                         self.steps_started += 1;
@@ -927,7 +933,7 @@ impl StepExecutor {
                 {
                     let dir = [cen[0] - obs.com[0], cen[1] - obs.com[1]];
                     let n = dir[0].hypot(dir[1]).max(1e-9);
-                    let want = (c.min_lift_margin_m + 0.01 - m) / 0.8;
+                    let want = (required + 0.01 - m) / 0.8;
                     let mut next = [
                         self.correction[0] + want * dir[0] / n,
                         self.correction[1] + want * dir[1] / n,
@@ -952,7 +958,7 @@ impl StepExecutor {
                 }
                 self.steps_aborted += 1;
                 self.fail(
-                    ExecFailure::StepAborted { leg, margin_m: m, required_m: c.min_lift_margin_m },
+                    ExecFailure::StepAborted { leg, margin_m: m, required_m: required },
                     time,
                 );
                 Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) }
