@@ -7,9 +7,9 @@
 
 mod common;
 
-use momaro::control::step_executor::ExecEventKind;
+use momaro::control::step_executor::{ExecEventKind, ExecFailure};
 use momaro::jobs::plan::{self, PathKind, PlanOptions, PlanSummary};
-use momaro::jobs::run::{self, Mission, Push, RunOptions, RunSummary};
+use momaro::jobs::run::{self, Mission, Push, PushWhen, RunOptions, RunSummary};
 use momaro::motion::{DetailedPath, Phase};
 use momaro::robot::Leg;
 use momaro::scenario::Scenario;
@@ -128,9 +128,7 @@ fn lateral_push_on_three_legs_puts_the_foot_down_and_the_step_is_retried() {
     // put the foot down at once, and retry the step once the margin is back.
     let sc = common::scenario("platform");
     let push = Push {
-        step: 2,
-        phase: Phase::Swing,
-        delay_s: 1.0,
+        when: PushWhen::Step { step: 2, phase: Phase::Swing, delay_s: 1.0 },
         force: [0.0, 100.0, 0.0],
         duration_s: 0.3,
     };
@@ -214,4 +212,49 @@ fn staircase_whole_mission_in_closed_loop_pitches_with_the_stairs() {
         "max pitch {} vs {expected}",
         s.max_pitch_deg
     );
+}
+
+#[test]
+fn an_aborted_step_returns_to_the_driving_posture_and_replans() {
+    // A lift threshold no posture can meet (30 cm): the first step is aborted without
+    // lifting, the robot returns to the driving posture where it stands, and the job
+    // replans from there (once). Until the motion generator expands the staircase's rear
+    // steps up (issue 5) the replan's expansion fails; after that, the replanned first
+    // step is aborted again and no replan is left. Either way the run stops, reported.
+    let mut sc = common::scenario("staircase");
+    sc.params.min_lift_margin_m = 0.3;
+    let opts = RunOptions {
+        max_replans: 1,
+        replan_time_limit_s: 30.0,
+        ..RunOptions::new(plan_options(), common::model())
+    };
+    let wall = Instant::now();
+    let mut sim = Simulation::new(&sc, &common::model()).expect("world compiles");
+    let robot = sim.robot().clone();
+    let plan = plan::run(&sc, &robot, &plan_options()).expect("plan");
+    let end = before_rear_step_up(&plan, 1);
+    let detailed = run::expand_mission(&sc, &mut sim, &plan, end).expect("prefix expands");
+    momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
+    let s = run::execute(&sc, &mut sim, Mission { plan, detailed }, &opts, wall).expect("runs");
+    println!("abort: {:?} / {:?}", s.failure, s.executor_events);
+    assert!(s.steps_aborted >= 1 && s.steps_executed == 0, "{s:#?}");
+    assert!(
+        !s.executor_events.iter().any(|e| matches!(e.event, ExecEventKind::Lift { .. })),
+        "a foot was lifted: {:?}",
+        s.executor_events
+    );
+    assert!(s.executor_events.iter().any(|e| matches!(
+        e.event,
+        ExecEventKind::Failure { failure: ExecFailure::StepAborted { .. } }
+    )));
+    assert_eq!(s.replans, 1);
+    let f = s.failure.clone().expect("the run stopped");
+    assert!(f.contains("replan") || f.contains("no replans left"), "{f}");
+    // Back at driving height: the base 0.32 m above the ground it stands on (first
+    // tread or floor), all eight wheels down, upright.
+    let base = sim.base();
+    let ground = sc.terrain_height(base.position[0], base.position[1]);
+    assert!((base.position[2] - ground - 0.32).abs() < 0.03, "{:?} over {ground}", base.position);
+    assert_eq!(sim.wheel_contacts().len(), 8);
+    assert!(!s.tipped && s.body_collisions.is_empty(), "{s:#?}");
 }

@@ -202,7 +202,7 @@ pub struct Command {
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum ExecFailure {
     /// The support margin stayed below the lift threshold after the corrections.
-    #[error("step of {leg:?} aborted: support margin {margin_m:.3} m below {required_m} m")]
+    #[error("step of {leg:?} aborted: support margin {margin_m:.3} m below {required_m:.3} m")]
     StepAborted {
         /// The stepping leg.
         leg: Leg,

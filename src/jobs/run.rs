@@ -125,15 +125,27 @@ impl RunOptions {
     }
 }
 
-/// A horizontal force on the base while a step's foot is in the air.
+/// When a push starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PushWhen {
+    /// At a simulated time, s.
+    At(f64),
+    /// During a step of the first plan.
+    Step {
+        /// The step (1-based, in execution order).
+        step: usize,
+        /// The phase of that step in which the push starts.
+        phase: Phase,
+        /// Delay after the phase starts, s.
+        delay_s: f64,
+    },
+}
+
+/// A force on the base for a while (disturbance tests).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Push {
-    /// The step (1-based, in execution order).
-    pub step: usize,
-    /// The phase of that step in which the push starts.
-    pub phase: Phase,
-    /// Delay after the phase starts, s.
-    pub delay_s: f64,
+    /// When it starts.
+    pub when: PushWhen,
     /// Force in the world frame, N.
     pub force: [f64; 3],
     /// Duration, s.
@@ -384,6 +396,18 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
     execute(scenario, &mut sim, mission, opts, wall)
 }
 
+/// An error and its sources, joined by ": ".
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut cur = e.source();
+    while let Some(c) = cur {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        cur = c.source();
+    }
+    s
+}
+
 /// What the executor sees of the simulation, with `measured` as the base pose.
 fn observe(sim: &Simulation, measured: Pose2) -> Observation {
     Observation {
@@ -526,7 +550,7 @@ pub fn execute(
                         continue;
                     }
                     Err(e) => {
-                        failure = Some(format!("replan after \"{f}\" failed: {e}"));
+                        failure = Some(format!("replan after \"{f}\" failed: {}", chain(&e)));
                         break;
                     }
                 }
@@ -542,14 +566,20 @@ pub fn execute(
         // The disturbance, if any.
         if let Some(p) = &opts.push {
             let now = sim.time();
-            let in_phase = replans == 0
-                && exec.active_step().is_some_and(|a| a.number == p.step)
-                && exec.phase() == Some(p.phase);
-            if in_phase && push_phase_start.is_none() {
-                push_phase_start = Some(now);
-            }
-            match (&mut push_report, push_phase_start) {
-                (None, Some(t0)) if now >= t0 + p.delay_s => {
+            let start = match p.when {
+                PushWhen::At(t) => Some(t),
+                PushWhen::Step { step, phase, delay_s } => {
+                    let in_phase = replans == 0
+                        && exec.active_step().is_some_and(|a| a.number == step)
+                        && exec.phase() == Some(phase);
+                    if in_phase && push_phase_start.is_none() {
+                        push_phase_start = Some(now);
+                    }
+                    push_phase_start.map(|t0| t0 + delay_s)
+                }
+            };
+            match (&mut push_report, start) {
+                (None, Some(t0)) if now >= t0 => {
                     push_report = Some(PushReport {
                         start_s: now,
                         margin_before_m: last_margin,
