@@ -12,14 +12,18 @@
 //! - **Other segments** track the linear interpolation between keyframes with a smoothstep
 //!   time law over the generator's keyframe time (longer if the servos lag): leg joint
 //!   targets from the sagittal IK of the interpolated posture (base height, roll, pitch,
-//!   feet). Stance wheels are held (the ankle keeps a planted wheel level, so it needs no
-//!   spin); a foot moved along the ground in contact (wheel to centre, wheel back, wheel
+//!   feet). A foot moved along the ground in contact (wheel to centre, wheel back, wheel
 //!   moves) rolls its pair at the foot's world speed over the wheel radius, steering
-//!   straight.
+//!   straight. Stance wheels need no spin (the ankle keeps a planted wheel level); since
+//!   the wheel actuators are velocity servos, a stance pair holds its wheel angles with a
+//!   proportional loop so the foot does not creep under the legs' horizontal forces.
 //! - **Before a lift** the support margin measured from MuJoCo (CoM over the wheel
 //!   contacts of the three support legs) must reach [`ExecutorConfig::min_lift_margin_m`]
-//!   (2 cm). If it does not, the base is shifted toward the support triangle's centroid in
-//!   bounded increments; if that does not suffice, the step is aborted (the foot is not
+//!   (2 cm) plus a reserve for the sag of the compliant support legs when the foot unloads
+//!   ([`ExecutorConfig::lift_margin_reserve_m`]). If it does not, the base is moved toward
+//!   the support triangle's centroid in bounded increments: longitudinally by a base shift,
+//!   laterally by a roll about the ground ([`correction_roll`]; the legs move only in their
+//!   sagittal planes). If that does not suffice, the step is aborted (the foot is not
 //!   lifted).
 //! - **While a foot is in the air** the support margin is watched; below
 //!   [`ExecutorConfig::emergency_margin_m`] the foot is put down where it is (lowered until
