@@ -555,11 +555,13 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                         serde_json::to_value(&s).context("serialising")?
                     }
                     Err(e) => {
+                        // The whole cause chain: "step motion generation: path element …".
+                        let e = format!("{:#}", run_error(e));
                         if !json {
                             say!("{:<16} {:<7} {e}", sc.name, "ERROR");
                         }
                         all_passed = false;
-                        serde_json::json!({ "scenario": sc.name, "passed": false, "error": e.to_string() })
+                        serde_json::json!({ "scenario": sc.name, "passed": false, "error": e })
                     }
                 };
                 rows.push(row);

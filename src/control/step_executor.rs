@@ -468,7 +468,7 @@ pub struct StepExecutor {
     last_legs: [[f64; 3]; 4],
     /// Wheel angles the stance wheels hold (None: not holding), rad.
     wheel_hold: [Option<[f64; 2]>; 4],
-    trace_time: f64,
+    now: f64,
     retries: usize,
     steps_started: usize,
     active: Option<ActiveStep>,
@@ -513,7 +513,7 @@ impl StepExecutor {
             landing: [0.0; 2],
             last_legs,
             wheel_hold: [None; 4],
-            trace_time: 0.0,
+            now: 0.0,
             retries: 0,
             steps_started: 0,
             active: None,
@@ -768,10 +768,9 @@ impl StepExecutor {
             .then_some(ExecFailure::Drift { distance_m, heading_rad })
     }
 
-    #[allow(clippy::too_many_lines)]
     fn step_mode(&mut self, obs: &Observation, dt: f64) -> Command {
         let time = obs.time;
-        self.trace_time = time;
+        self.now = time;
         let mode = std::mem::replace(&mut self.mode, Mode::Finished);
         match mode {
             Mode::Finished => {
@@ -782,318 +781,387 @@ impl StepExecutor {
                 self.mode = Mode::Stopped(f);
                 self.hold()
             }
-            Mode::Drive { mut follower, first, last } => {
-                let out = follower.update(obs.base, dt);
-                if out.status == FollowerStatus::Finished {
-                    self.cmd = self.keys[last].posture();
-                    self.advance(last + 1, time);
-                    let _ = first;
-                    return self.hold();
-                }
-                if out.cross_track_m.abs() > self.config.drift_tolerance_m {
-                    self.cmd = self.keys[(first - 1 + out.progress_index).min(last)].posture();
-                    self.fail(
-                        ExecFailure::Drift {
-                            distance_m: out.cross_track_m.abs(),
-                            heading_rad: out.heading_error_rad,
-                        },
-                        time,
-                    );
-                    return self.hold();
-                }
-                // The keyframe posture at the robot's progress along the run.
-                let path = follower.path();
-                let k = out.progress_index.min(path.len() - 1);
-                let a_idx = first - 1 + k;
-                let p = if k + 1 < path.len() {
-                    let (a, b) = (path[k], path[k + 1]);
-                    let (dx, dy) = (b.x - a.x, b.y - a.y);
-                    let len2 = dx * dx + dy * dy;
-                    let t = if len2 > 1e-8 {
-                        ((obs.base.x - a.x) * dx + (obs.base.y - a.y) * dy) / len2
-                    } else {
-                        let dth = wrap_angle(b.theta - a.theta);
-                        if dth.abs() > 1e-6 {
-                            wrap_angle(obs.base.theta - a.theta) / dth
-                        } else {
-                            1.0
-                        }
-                    };
-                    interpolate(
-                        &self.keys[a_idx].posture(),
-                        &self.keys[a_idx + 1].posture(),
-                        t.clamp(0.0, 1.0),
-                    )
-                } else {
-                    self.keys[a_idx].posture()
-                };
-                self.cmd = p;
-                self.wheel_hold = [None; 4];
-                self.mode = Mode::Drive { follower, first, last };
-                let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
-                let local = contacts_in_base(&self.robot, &p);
-                let feet: [[f64; 2]; 4] = std::array::from_fn(|i| {
-                    [local[i][0] + self.robot.hips[i][0], local[i][1] + self.robot.hips[i][1]]
-                });
-                let wheels =
-                    self.config.wheels.commands(&self.robot, out.twist, &feet, &obs.steering);
-                Command { legs, wheels: self.with_steer_rate(wheels, obs) }
+            Mode::Drive { follower, first, last } => {
+                self.drive_tick(obs, dt, follower, first, last)
             }
-            Mode::Segment { from, index, mut elapsed, duration, mut settle } => {
-                let c = &self.config;
-                let rate = clock_rate(
-                    self.tracking_error(obs),
-                    c.slowdown_start_rad,
-                    c.slowdown_full_rad,
-                    c.slowest_rate,
-                );
-                let k = &self.keys[index];
-                let (phase, leg) = (k.phase, k.leg);
-                let to = k.posture();
-                elapsed = (elapsed + dt * rate).min(duration);
-                let s = elapsed / duration;
-                let w = smoothstep(s);
-                let dw = smoothstep_rate(s) * rate / duration;
-                let mut p = interpolate(&from, &to, w);
-                p.contact = std::array::from_fn(|i| from.contact[i] && to.contact[i]);
-                // Offsets of the stepping leg: faded out during the lift, the landing
-                // offset faded in during the swing.
-                if let Some(l) = leg {
-                    let i = l.index();
-                    match phase {
-                        Phase::Lift => {
-                            self.foot_offset[i] = self.lift_offset.map(|o| o * (1.0 - w));
-                        }
-                        Phase::Swing => {
-                            self.foot_offset[i] = [self.landing[0] * w, self.landing[1] * w, 0.0];
-                        }
-                        Phase::Place => {
-                            self.foot_offset[i] = [self.landing[0], self.landing[1], 0.0];
-                        }
-                        _ => {}
-                    }
-                }
-                if let Some(c0) = self.fading {
-                    self.correction = c0.map(|v| v * (1.0 - w));
-                }
-                let commanded = self.with_offsets(&p);
-                self.cmd = p;
-                if let Some(f) = self.drift(obs, &commanded) {
-                    self.fail(f, time);
-                    return self.hold();
-                }
-                // A foot in the air: watch the support margin.
-                if let Some(l) = leg
-                    && matches!(phase, Phase::Lift | Phase::Swing | Phase::Place)
-                {
-                    let m = obs.support_margin(l);
-                    let airborne = phase != Phase::Place || !obs.leg_in_contact(l);
-                    if airborne && m < self.config.emergency_margin_m {
-                        self.event(time, ExecEventKind::FootPutDown { leg: l, margin_m: m });
-                        let lift = self.lift_index(index);
-                        let then = if self.retries < self.config.max_step_retries {
-                            self.retries += 1;
-                            AfterPutDown::Retry(lift)
-                        } else {
-                            self.steps_aborted += 1;
-                            self.active = None;
-                            AfterPutDown::Recover(ExecFailure::StepAborted {
-                                leg: l,
-                                margin_m: m,
-                                required_m: self.config.min_lift_margin_m,
-                            })
-                        };
-                        self.start_put_down(l, then);
-                        return self.hold();
-                    }
-                }
-                let Some(legs) = self.legs_for(&commanded, time) else { return self.hold() };
-                let vel: [[f64; 2]; 4] = std::array::from_fn(|i| {
-                    [(to.feet[i][0] - from.feet[i][0]) * dw, (to.feet[i][1] - from.feet[i][1]) * dw]
-                });
-                let wheels = self.rolling(&p, &vel, obs);
-                if elapsed >= duration {
-                    settle += dt;
-                    if self.tracking_error(obs) < self.config.settle_tolerance_rad
-                        || settle >= self.config.max_settle_s
-                    {
-                        self.finish_segment(index, phase, leg);
-                        return Command { legs, wheels };
-                    }
-                }
-                self.mode = Mode::Segment { from, index, elapsed, duration, settle };
-                Command { legs, wheels }
+            Mode::Segment { from, index, elapsed, duration, settle } => {
+                self.segment_tick(obs, dt, from, index, elapsed, duration, settle)
             }
-            Mode::Guard { index, mut wait, mut attempts, corr_from } => {
-                let leg = self.keys[index].leg.unwrap_or(Leg::FrontLeft);
-                let c = self.config.clone();
-                wait += dt;
-                let ramp = if attempts == 0 { 1.0 } else { smoothstep(wait / c.correction_time_s) };
-                let target = self.correction;
-                let applied = [
-                    corr_from[0] + (target[0] - corr_from[0]) * ramp,
-                    corr_from[1] + (target[1] - corr_from[1]) * ramp,
-                ];
-                let saved = self.correction;
-                self.correction = applied;
-                let p = self.with_offsets(&self.cmd);
-                self.correction = saved;
-                let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
-                let ready =
-                    wait >= c.lift_settle_s + if attempts == 0 { 0.0 } else { c.correction_time_s };
-                if !ready {
-                    self.mode = Mode::Guard { index, wait, attempts, corr_from };
-                    return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
-                }
-                let m = obs.support_margin(leg);
-                let required = c.min_lift_margin_m
-                    + c.lift_margin_reserve_m
-                    + self.retries as f64 * c.retry_margin_increment_m;
-                if m >= required {
-                    self.event(time, ExecEventKind::Lift { leg, margin_m: m });
-                    if self.retries == 0 {
-                        self.steps_started += 1;
-                    }
-                    self.active = Some(ActiveStep { number: self.steps_started, leg });
-                    self.lift_offset = self.foot_offset[leg.index()];
-                    // Landing: the drift of the measured base, frozen now.
-                    let place = self.place_index(index);
-                    let foothold = self.keys[place].feet[leg.index()];
-                    self.landing = landing_offset(planar(&p), obs.base, [foothold[0], foothold[1]]);
-                    self.fading = None;
-                    self.start_segment(index);
-                    return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
-                }
-                let centroid = obs.support_centroid(leg);
-                let total = self.correction[0].hypot(self.correction[1]);
-                if attempts < c.max_correction_attempts
-                    && total < c.max_correction_m - 1e-6
-                    && let Some(cen) = centroid
-                {
-                    let dir = [cen[0] - obs.com[0], cen[1] - obs.com[1]];
-                    let n = dir[0].hypot(dir[1]).max(1e-9);
-                    let want = (required + 0.01 - m) / 0.8;
-                    let mut next = [
-                        self.correction[0] + want * dir[0] / n,
-                        self.correction[1] + want * dir[1] / n,
-                    ];
-                    let len = next[0].hypot(next[1]);
-                    if len > c.max_correction_m {
-                        next = next.map(|v| v * c.max_correction_m / len);
-                    }
-                    let from = self.correction;
-                    self.correction = next;
-                    self.event(
-                        time,
-                        ExecEventKind::Correction {
-                            leg,
-                            margin_m: m,
-                            correction_m: next[0].hypot(next[1]),
-                        },
-                    );
-                    attempts += 1;
-                    self.mode = Mode::Guard { index, wait: 0.0, attempts, corr_from: from };
-                    return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
-                }
-                self.steps_aborted += 1;
-                self.fail(
-                    ExecFailure::StepAborted { leg, margin_m: m, required_m: required },
-                    time,
-                );
-                Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) }
+            Mode::Guard { index, wait, attempts, corr_from } => {
+                self.guard_tick(obs, dt, index, wait, attempts, corr_from)
             }
-            Mode::Confirm { index, mut confirm } => {
-                let leg = self.keys[index].leg.unwrap_or(Leg::FrontLeft);
-                let status = confirm.update(obs.leg_in_contact(leg), dt);
-                let i = leg.index();
-                match status {
-                    ContactStatus::Pending { extra_m } | ContactStatus::Confirmed { extra_m } => {
-                        self.foot_offset[i][2] = -extra_m;
-                    }
-                    ContactStatus::Failed { .. } => {}
-                }
-                let p = self.with_offsets(&self.cmd);
-                let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
-                let wheels = self.rolling(&p, &[[0.0; 2]; 4], obs);
-                match status {
-                    ContactStatus::Pending { .. } => {
-                        self.mode = Mode::Confirm { index, confirm };
-                    }
-                    ContactStatus::Confirmed { extra_m } => {
-                        self.steps_executed += 1;
-                        self.active = None;
-                        self.event(time, ExecEventKind::StepExecuted { leg, extra_m });
-                        self.fading = Some(self.correction);
-                        self.advance(index + 1, time);
-                    }
-                    ContactStatus::Failed { extra_m } => {
-                        self.steps_aborted += 1;
-                        self.cmd.contact[i] = false;
-                        self.fail(ExecFailure::NoContact { leg, extra_m }, time);
-                    }
-                }
-                Command { legs, wheels }
+            Mode::Confirm { index, confirm } => self.confirm_tick(obs, dt, index, confirm),
+            Mode::PutDown { leg, lowered, floor, confirm, then } => {
+                self.put_down_tick(obs, dt, leg, lowered, floor, confirm, then)
             }
-            Mode::PutDown { leg, mut lowered, floor, mut confirm, then } => {
-                let i = leg.index();
-                let status = confirm.update(obs.leg_in_contact(leg), dt);
-                if matches!(status, ContactStatus::Pending { .. }) {
-                    let z = self.cmd.feet[i][2] - lowered;
-                    if z > floor {
-                        lowered += self.config.put_down_speed_mps * dt;
-                    }
-                }
-                let mut p = self.cmd;
-                p.feet[i][2] -= lowered;
-                let p_off = self.with_offsets(&p);
-                let legs = self.legs_or_hold(&p_off);
-                let wheels = self.rolling(&p_off, &[[0.0; 2]; 4], obs);
-                let at_floor = self.cmd.feet[i][2] - lowered <= floor;
-                match status {
-                    ContactStatus::Confirmed { .. } => {
-                        self.cmd = p;
-                        self.cmd.contact[i] = true;
-                        match then {
-                            AfterPutDown::Retry(lift) => {
-                                self.mode = Mode::Guard {
-                                    index: lift,
-                                    wait: 0.0,
-                                    attempts: 0,
-                                    corr_from: self.correction,
-                                };
-                            }
-                            AfterPutDown::Recover(f) => self.start_recover(f),
-                        }
-                    }
-                    _ if at_floor => {
-                        let f = ExecFailure::NoContact { leg, extra_m: lowered };
-                        self.event(time, ExecEventKind::Failure { failure: f.clone() });
-                        self.mode = Mode::Stopped(f);
-                    }
-                    _ => self.mode = Mode::PutDown { leg, lowered, floor, confirm, then },
-                }
-                Command { legs, wheels }
-            }
-            Mode::Recover { from, to, mut elapsed, duration, failure } => {
-                elapsed = (elapsed + dt).min(duration);
-                let s = elapsed / duration;
-                let w = smoothstep(s);
-                let dw = smoothstep_rate(s) / duration;
-                let p = interpolate(&from, &to, w);
-                self.cmd = p;
-                let legs = self.legs_or_hold(&p);
-                let vel: [[f64; 2]; 4] = std::array::from_fn(|i| {
-                    [(to.feet[i][0] - from.feet[i][0]) * dw, (to.feet[i][1] - from.feet[i][1]) * dw]
-                });
-                let wheels = self.rolling(&p, &vel, obs);
-                self.mode = if elapsed >= duration {
-                    Mode::Stopped(failure)
-                } else {
-                    Mode::Recover { from, to, elapsed, duration, failure }
-                };
-                Command { legs, wheels }
+            Mode::Recover { from, to, elapsed, duration, failure } => {
+                self.recover_tick(obs, dt, from, to, elapsed, duration, failure)
             }
         }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn drive_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        mut follower: Box<PathFollower>,
+        first: usize,
+        last: usize,
+    ) -> Command {
+        let time = obs.time;
+        let out = follower.update(obs.base, dt);
+        if out.status == FollowerStatus::Finished {
+            self.cmd = self.keys[last].posture();
+            self.advance(last + 1, time);
+            return self.hold();
+        }
+        if out.cross_track_m.abs() > self.config.drift_tolerance_m {
+            self.cmd = self.keys[(first - 1 + out.progress_index).min(last)].posture();
+            self.fail(
+                ExecFailure::Drift {
+                    distance_m: out.cross_track_m.abs(),
+                    heading_rad: out.heading_error_rad,
+                },
+                time,
+            );
+            return self.hold();
+        }
+        // The keyframe posture at the robot's progress along the run.
+        let path = follower.path();
+        let k = out.progress_index.min(path.len() - 1);
+        let a_idx = first - 1 + k;
+        let p = if k + 1 < path.len() {
+            let (a, b) = (path[k], path[k + 1]);
+            let (dx, dy) = (b.x - a.x, b.y - a.y);
+            let len2 = dx * dx + dy * dy;
+            let t = if len2 > 1e-8 {
+                ((obs.base.x - a.x) * dx + (obs.base.y - a.y) * dy) / len2
+            } else {
+                let dth = wrap_angle(b.theta - a.theta);
+                if dth.abs() > 1e-6 { wrap_angle(obs.base.theta - a.theta) / dth } else { 1.0 }
+            };
+            interpolate(
+                &self.keys[a_idx].posture(),
+                &self.keys[a_idx + 1].posture(),
+                t.clamp(0.0, 1.0),
+            )
+        } else {
+            self.keys[a_idx].posture()
+        };
+        self.cmd = p;
+        self.wheel_hold = [None; 4];
+        self.mode = Mode::Drive { follower, first, last };
+        let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
+        let local = contacts_in_base(&self.robot, &p);
+        let feet: [[f64; 2]; 4] = std::array::from_fn(|i| {
+            [local[i][0] + self.robot.hips[i][0], local[i][1] + self.robot.hips[i][1]]
+        });
+        let wheels = self.config.wheels.commands(&self.robot, out.twist, &feet, &obs.steering);
+        Command { legs, wheels: self.with_steer_rate(wheels, obs) }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn segment_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        from: Posture,
+        index: usize,
+        mut elapsed: f64,
+        duration: f64,
+        mut settle: f64,
+    ) -> Command {
+        let time = obs.time;
+        let c = &self.config;
+        let rate = clock_rate(
+            self.tracking_error(obs),
+            c.slowdown_start_rad,
+            c.slowdown_full_rad,
+            c.slowest_rate,
+        );
+        let k = &self.keys[index];
+        let (phase, leg) = (k.phase, k.leg);
+        let to = k.posture();
+        elapsed = (elapsed + dt * rate).min(duration);
+        let s = elapsed / duration;
+        let w = smoothstep(s);
+        let dw = smoothstep_rate(s) * rate / duration;
+        let mut p = interpolate(&from, &to, w);
+        p.contact = std::array::from_fn(|i| from.contact[i] && to.contact[i]);
+        // Offsets of the stepping leg: faded out during the lift, the landing
+        // offset faded in during the swing.
+        if let Some(l) = leg {
+            let i = l.index();
+            match phase {
+                Phase::Lift => {
+                    self.foot_offset[i] = self.lift_offset.map(|o| o * (1.0 - w));
+                }
+                Phase::Swing => {
+                    self.foot_offset[i] = [self.landing[0] * w, self.landing[1] * w, 0.0];
+                }
+                Phase::Place => {
+                    self.foot_offset[i] = [self.landing[0], self.landing[1], 0.0];
+                }
+                _ => {}
+            }
+        }
+        if let Some(c0) = self.fading {
+            self.correction = c0.map(|v| v * (1.0 - w));
+        }
+        let commanded = self.with_offsets(&p);
+        self.cmd = p;
+        if let Some(f) = self.drift(obs, &commanded) {
+            self.fail(f, time);
+            return self.hold();
+        }
+        // A foot in the air: watch the support margin.
+        if let Some(l) = leg
+            && matches!(phase, Phase::Lift | Phase::Swing | Phase::Place)
+        {
+            let m = obs.support_margin(l);
+            let airborne = phase != Phase::Place || !obs.leg_in_contact(l);
+            if airborne && m < self.config.emergency_margin_m {
+                self.event(time, ExecEventKind::FootPutDown { leg: l, margin_m: m });
+                let lift = self.lift_index(index);
+                let then = if self.retries < self.config.max_step_retries {
+                    self.retries += 1;
+                    AfterPutDown::Retry(lift)
+                } else {
+                    self.steps_aborted += 1;
+                    self.active = None;
+                    AfterPutDown::Recover(ExecFailure::StepAborted {
+                        leg: l,
+                        margin_m: m,
+                        required_m: self.config.min_lift_margin_m,
+                    })
+                };
+                self.start_put_down(l, then);
+                return self.hold();
+            }
+        }
+        let Some(legs) = self.legs_for(&commanded, time) else { return self.hold() };
+        let vel: [[f64; 2]; 4] = std::array::from_fn(|i| {
+            [(to.feet[i][0] - from.feet[i][0]) * dw, (to.feet[i][1] - from.feet[i][1]) * dw]
+        });
+        let wheels = self.rolling(&p, &vel, obs);
+        if elapsed >= duration {
+            settle += dt;
+            if self.tracking_error(obs) < self.config.settle_tolerance_rad
+                || settle >= self.config.max_settle_s
+            {
+                self.finish_segment(index, phase, leg);
+                return Command { legs, wheels };
+            }
+        }
+        self.mode = Mode::Segment { from, index, elapsed, duration, settle };
+        Command { legs, wheels }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn guard_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        index: usize,
+        mut wait: f64,
+        mut attempts: usize,
+        corr_from: [f64; 2],
+    ) -> Command {
+        let time = obs.time;
+        let leg = self.keys[index].leg.unwrap_or(Leg::FrontLeft);
+        let c = self.config.clone();
+        wait += dt;
+        let ramp = if attempts == 0 { 1.0 } else { smoothstep(wait / c.correction_time_s) };
+        let target = self.correction;
+        let applied = [
+            corr_from[0] + (target[0] - corr_from[0]) * ramp,
+            corr_from[1] + (target[1] - corr_from[1]) * ramp,
+        ];
+        let saved = self.correction;
+        self.correction = applied;
+        let p = self.with_offsets(&self.cmd);
+        self.correction = saved;
+        let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
+        let ready = wait >= c.lift_settle_s + if attempts == 0 { 0.0 } else { c.correction_time_s };
+        if !ready {
+            self.mode = Mode::Guard { index, wait, attempts, corr_from };
+            return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
+        }
+        let m = obs.support_margin(leg);
+        let required = c.min_lift_margin_m
+            + c.lift_margin_reserve_m
+            + self.retries as f64 * c.retry_margin_increment_m;
+        if m >= required {
+            self.event(time, ExecEventKind::Lift { leg, margin_m: m });
+            if self.retries == 0 {
+                self.steps_started += 1;
+            }
+            self.active = Some(ActiveStep { number: self.steps_started, leg });
+            self.lift_offset = self.foot_offset[leg.index()];
+            // Landing: the drift of the measured base, frozen now.
+            let place = self.place_index(index);
+            let foothold = self.keys[place].feet[leg.index()];
+            self.landing = landing_offset(planar(&p), obs.base, [foothold[0], foothold[1]]);
+            self.fading = None;
+            self.start_segment(index);
+            return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
+        }
+        let centroid = obs.support_centroid(leg);
+        let total = self.correction[0].hypot(self.correction[1]);
+        if attempts < c.max_correction_attempts
+            && total < c.max_correction_m - 1e-6
+            && let Some(cen) = centroid
+        {
+            let dir = [cen[0] - obs.com[0], cen[1] - obs.com[1]];
+            let n = dir[0].hypot(dir[1]).max(1e-9);
+            let want = (required + 0.01 - m) / 0.8;
+            let mut next =
+                [self.correction[0] + want * dir[0] / n, self.correction[1] + want * dir[1] / n];
+            let len = next[0].hypot(next[1]);
+            if len > c.max_correction_m {
+                next = next.map(|v| v * c.max_correction_m / len);
+            }
+            let from = self.correction;
+            self.correction = next;
+            self.event(
+                time,
+                ExecEventKind::Correction {
+                    leg,
+                    margin_m: m,
+                    correction_m: next[0].hypot(next[1]),
+                },
+            );
+            attempts += 1;
+            self.mode = Mode::Guard { index, wait: 0.0, attempts, corr_from: from };
+            return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
+        }
+        self.steps_aborted += 1;
+        self.fail(ExecFailure::StepAborted { leg, margin_m: m, required_m: required }, time);
+        Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn confirm_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        index: usize,
+        mut confirm: ContactConfirm,
+    ) -> Command {
+        let time = obs.time;
+        let leg = self.keys[index].leg.unwrap_or(Leg::FrontLeft);
+        let status = confirm.update(obs.leg_in_contact(leg), dt);
+        let i = leg.index();
+        match status {
+            ContactStatus::Pending { extra_m } | ContactStatus::Confirmed { extra_m } => {
+                self.foot_offset[i][2] = -extra_m;
+            }
+            ContactStatus::Failed { .. } => {}
+        }
+        let p = self.with_offsets(&self.cmd);
+        let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
+        let wheels = self.rolling(&p, &[[0.0; 2]; 4], obs);
+        match status {
+            ContactStatus::Pending { .. } => {
+                self.mode = Mode::Confirm { index, confirm };
+            }
+            ContactStatus::Confirmed { extra_m } => {
+                self.steps_executed += 1;
+                self.active = None;
+                self.event(time, ExecEventKind::StepExecuted { leg, extra_m });
+                self.fading = Some(self.correction);
+                self.advance(index + 1, time);
+            }
+            ContactStatus::Failed { extra_m } => {
+                self.steps_aborted += 1;
+                self.cmd.contact[i] = false;
+                self.fail(ExecFailure::NoContact { leg, extra_m }, time);
+            }
+        }
+        Command { legs, wheels }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn put_down_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        leg: Leg,
+        mut lowered: f64,
+        floor: f64,
+        mut confirm: ContactConfirm,
+        then: AfterPutDown,
+    ) -> Command {
+        let time = obs.time;
+        let i = leg.index();
+        let status = confirm.update(obs.leg_in_contact(leg), dt);
+        if matches!(status, ContactStatus::Pending { .. }) {
+            let z = self.cmd.feet[i][2] - lowered;
+            if z > floor {
+                lowered += self.config.put_down_speed_mps * dt;
+            }
+        }
+        let mut p = self.cmd;
+        p.feet[i][2] -= lowered;
+        let p_off = self.with_offsets(&p);
+        let legs = self.legs_or_hold(&p_off);
+        let wheels = self.rolling(&p_off, &[[0.0; 2]; 4], obs);
+        let at_floor = self.cmd.feet[i][2] - lowered <= floor;
+        match status {
+            ContactStatus::Confirmed { .. } => {
+                self.cmd = p;
+                self.cmd.contact[i] = true;
+                match then {
+                    AfterPutDown::Retry(lift) => {
+                        self.mode = Mode::Guard {
+                            index: lift,
+                            wait: 0.0,
+                            attempts: 0,
+                            corr_from: self.correction,
+                        };
+                    }
+                    AfterPutDown::Recover(f) => self.start_recover(f),
+                }
+            }
+            _ if at_floor => {
+                let f = ExecFailure::NoContact { leg, extra_m: lowered };
+                self.event(time, ExecEventKind::Failure { failure: f.clone() });
+                self.mode = Mode::Stopped(f);
+            }
+            _ => self.mode = Mode::PutDown { leg, lowered, floor, confirm, then },
+        }
+        Command { legs, wheels }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn recover_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        from: Posture,
+        to: Posture,
+        mut elapsed: f64,
+        duration: f64,
+        failure: ExecFailure,
+    ) -> Command {
+        elapsed = (elapsed + dt).min(duration);
+        let s = elapsed / duration;
+        let w = smoothstep(s);
+        let dw = smoothstep_rate(s) / duration;
+        let p = interpolate(&from, &to, w);
+        self.cmd = p;
+        let legs = self.legs_or_hold(&p);
+        let vel: [[f64; 2]; 4] = std::array::from_fn(|i| {
+            [(to.feet[i][0] - from.feet[i][0]) * dw, (to.feet[i][1] - from.feet[i][1]) * dw]
+        });
+        let wheels = self.rolling(&p, &vel, obs);
+        self.mode = if elapsed >= duration {
+            Mode::Stopped(failure)
+        } else {
+            Mode::Recover { from, to, elapsed, duration, failure }
+        };
+        Command { legs, wheels }
     }
 
     fn finish_segment(&mut self, index: usize, phase: Phase, leg: Option<Leg>) {
@@ -1106,7 +1174,7 @@ impl StepExecutor {
             self.fading = None;
             self.correction = [0.0; 2];
         }
-        self.advance(index + 1, self.trace_time);
+        self.advance(index + 1, self.now);
     }
 
     /// The lift keyframe of the step whose keyframe `index` is part of.
