@@ -93,6 +93,19 @@ pub struct Params {
     /// stability, issue 7): 2 cm, the smallest margin the paper's scenarios expect during
     /// execution.
     pub min_lift_margin_m: f64,
+    /// Longest wheel-to-centre move of the stepping side's other wheel pair (Sec. VI-A,
+    /// Fig. 12a), m. Ours: 0.45 m.
+    pub max_wheel_to_centre_m: f64,
+    /// Smallest longitudinal gap the displaced wheel pair keeps to the stepping foot, m.
+    /// Ours: 0.3 m (two wheel pairs' length with room to spare).
+    pub wheel_gap_m: f64,
+    /// Planner's support check for a step: the signed distance of the base centre to the
+    /// support triangle of the other three feet (the partner wheel moved toward the
+    /// centre as the generator would) must be at least this, m. Base roll (eqs. 6–8) and a
+    /// base shift take the CoM the rest of the way. Ours: 0.05 m, about how far the CoM
+    /// projects behind the base centre with the base pitched on the stairs (the paper
+    /// leaves stability to the generator, whose failures it does not report).
+    pub step_support_margin_m: f64,
 
     /// ARA*: initial heuristic weight (Sec. VIII): 3.0.
     pub arastar_initial_epsilon: f64,
@@ -131,6 +144,9 @@ impl Default for Params {
             base_pitch_slope_fraction: 0.7,
             min_stability_margin_m: 0.03,
             min_lift_margin_m: 0.02,
+            max_wheel_to_centre_m: 0.45,
+            wheel_gap_m: 0.3,
+            step_support_margin_m: 0.05,
             arastar_initial_epsilon: 3.0,
             arastar_epsilon_decay: 0.5,
         }
@@ -155,7 +171,7 @@ impl Params {
     /// # Errors
     /// The first invalid field, by name.
     pub fn validate(&self) -> Result<(), InvalidParam> {
-        let positive: [(&'static str, f64); 14] = [
+        let positive: [(&'static str, f64); 16] = [
             ("grid_resolution_m", self.grid_resolution_m),
             ("r_f_m", self.r_f_m),
             ("r_n_m", self.r_n_m),
@@ -170,6 +186,8 @@ impl Params {
             ("driving_leg_height_m", self.driving_leg_height_m),
             ("manoeuvre_leg_height_m", self.manoeuvre_leg_height_m),
             ("arastar_initial_epsilon", self.arastar_initial_epsilon),
+            ("max_wheel_to_centre_m", self.max_wheel_to_centre_m),
+            ("wheel_gap_m", self.wheel_gap_m),
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
@@ -196,6 +214,13 @@ impl Params {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(InvalidParam { name, value, reason: "must be a finite number >= 0" });
             }
+        }
+        if !self.step_support_margin_m.is_finite() {
+            return Err(InvalidParam {
+                name: "step_support_margin_m",
+                value: self.step_support_margin_m,
+                reason: "must be a finite number",
+            });
         }
         if self.orientations < 4 || !self.orientations.is_multiple_of(4) {
             return Err(InvalidParam {

@@ -3,10 +3,9 @@
 //! stable by MuJoCo's CoM (`Simulation` as the `CenterOfMassModel`) and within the legs'
 //! reach and joint limits.
 //!
-//! Status: the expansion does not yet succeed on whole plans (see the ignored tests): the
-//! staircase fails at the first rear-right step, the platform at the first rear step onto
-//! the platform (the rear leg stretched 0.4 m behind its hip cannot take the roll or base
-//! shift that stability needs). The passing tests cover the path up to those steps.
+//! Planner and generator share the standing leg-height rule of Sec. VI-B
+//! (`motion::standing`), so every planned footprint can be stood in; the planner's support
+//! check keeps steps the alignment manoeuvres can stabilise.
 
 use momaro::jobs::plan::{self, PathElement, PathKind, PlanOptions, PlanSummary};
 use momaro::locomotion::Algorithm;
@@ -26,8 +25,11 @@ fn sim() -> Simulation {
 }
 
 fn planned(s: &Scenario, sim: &Simulation) -> PlanSummary {
-    let opts =
-        PlanOptions { algorithm: Algorithm::AraStar, time_limit_s: 60.0, ..PlanOptions::default() };
+    let opts = PlanOptions {
+        algorithm: Algorithm::AraStar,
+        time_limit_s: 200.0,
+        ..PlanOptions::default()
+    };
     plan::run(s, sim.robot(), &opts).expect("plan")
 }
 
@@ -95,85 +97,75 @@ fn report(s: &Scenario, end: usize, total: usize, d: &DetailedPath) {
     );
 }
 
-#[test]
-fn staircase_front_steps_and_first_rear_step_are_stable() {
-    let s = scenario("staircase");
-    let mut sim = sim();
-    let p = planned(&s, &sim);
-    // Up to (excluding) the second rear step up: the front steps onto the first two treads
-    // and the first rear-left step.
-    let end = before_rear_step_up(&p, 1);
-    let d = expand(&s, &mut sim, &p.path[..end]).expect("expansion");
-    report(&s, end, p.path.len(), &d);
-    check(&d, &sim);
-    let ph = phases(&d);
-    for want in [
-        Phase::StandUp,
-        Phase::Roll,
-        Phase::WheelToCentre,
-        Phase::Lift,
-        Phase::Swing,
-        Phase::Place,
-        Phase::WheelBack,
-        Phase::RollBack,
-        Phase::PlannedBaseShift,
-        Phase::WheelMove,
-    ] {
+/// The manoeuvres (Sec. VI-A) every whole expansion must contain.
+const STEP_PHASES: [Phase; 9] = [
+    Phase::StandUp,
+    Phase::Roll,
+    Phase::WheelToCentre,
+    Phase::Lift,
+    Phase::Swing,
+    Phase::Place,
+    Phase::WheelBack,
+    Phase::RollBack,
+    Phase::Lower,
+];
+
+/// Every planned step expanded, front and rear legs among them, with three contacts and
+/// the margin kept while a foot is in the air.
+fn check_steps(p: &PlanSummary, d: &DetailedPath) {
+    assert_eq!(d.steps, p.steps);
+    let ph = phases(d);
+    for want in STEP_PHASES {
         assert!(ph.contains(&want), "{want:?} missing");
     }
     let stepped: Vec<Leg> =
         d.keyframes.iter().filter(|k| k.phase == Phase::Place).filter_map(|k| k.leg).collect();
+    assert_eq!(stepped.len(), p.steps);
     assert!(stepped.iter().any(|l| l.is_front()) && stepped.iter().any(|l| !l.is_front()));
-    // Three contacts while the foot is in the air, with the margin kept.
     assert!(d.min_three_contact_margin_m >= 0.03 && d.min_three_contact_margin_m.is_finite());
 }
 
 #[test]
-fn platform_path_up_to_the_rear_steps_onto_the_platform_is_stable() {
-    let s = scenario("platform");
-    let mut sim = sim();
-    let p = planned(&s, &sim);
-    let end = before_rear_step_up(&p, 0);
-    let d = expand(&s, &mut sim, &p.path[..end]).expect("expansion");
-    report(&s, end, p.path.len(), &d);
-    check(&d, &sim);
-    assert!(d.steps >= 2, "front steps onto the platform: {}", d.steps);
-    let ph = phases(&d);
-    assert!(ph.contains(&Phase::Roll) && ph.contains(&Phase::Lower) && ph.contains(&Phase::Drive));
-}
-
-#[test]
-fn failure_names_the_step_and_leg() {
-    let s = scenario("staircase");
-    let mut sim = sim();
-    let p = planned(&s, &sim);
-    let end = before_rear_step_up(&p, 1);
-    match expand(&s, &mut sim, &p.path) {
-        Ok(_) => {}
-        Err(MotionError::Step { index, best_margin_m, required_m, .. }) => {
-            assert!(index >= end);
-            assert!(best_margin_m < required_m);
-        }
-        Err(e) => panic!("unexpected error {e}"),
-    }
-}
-
-#[test]
-#[ignore = "issue 5 unfinished: rear steps up with the rear leg 0.4 m behind its hip"]
 fn staircase_whole_path_is_stable() {
     let s = scenario("staircase");
     let mut sim = sim();
     let p = planned(&s, &sim);
     let d = expand(&s, &mut sim, &p.path).expect("expansion");
+    report(&s, p.path.len(), p.path.len(), &d);
     check(&d, &sim);
+    check_steps(&p, &d);
+    // Rear steps up the treads, with the planner's base shifts and wheel moves between.
+    let ph = phases(&d);
+    assert!(ph.contains(&Phase::PlannedBaseShift) && ph.contains(&Phase::WheelMove));
+    assert!(before_rear_step_up(&p, 1) < p.path.len(), "two rear steps up");
 }
 
 #[test]
-#[ignore = "issue 5 unfinished: rear steps up with the rear leg 0.4 m behind its hip"]
-fn platform_whole_path_is_stable() {
+fn platform_whole_path_is_stable_and_failures_name_the_step() {
     let s = scenario("platform");
     let mut sim = sim();
     let p = planned(&s, &sim);
     let d = expand(&s, &mut sim, &p.path).expect("expansion");
+    report(&s, p.path.len(), p.path.len(), &d);
     check(&d, &sim);
+    check_steps(&p, &d);
+    // All four feet end on the platform; a stabilising base shift (Fig. 12b) is used and
+    // reversed.
+    assert!(d.keyframes.last().is_some_and(|k| k.feet.iter().all(|f| f[2] > 0.15)));
+    let ph = phases(&d);
+    assert!(ph.contains(&Phase::BaseShift) && ph.contains(&Phase::ShiftBack));
+
+    // The same path with an unreachable margin fails at its first step, naming it.
+    let robot = sim.robot().clone();
+    let prep = plan::prepare(&s, &robot, None, None).expect("maps");
+    let options = MotionOptions { min_margin_m: 0.5, ..MotionOptions::from_params(&prep.params) };
+    let first = p.path.iter().position(|e| e.kind == PathKind::Step).expect("a step");
+    match expand_path(&p.path, &robot, &prep.maps, &mut sim, &options) {
+        Err(MotionError::Step { index, leg, best_margin_m, required_m, .. }) => {
+            assert_eq!(index, first);
+            assert_eq!(Some(leg), p.path[first].leg);
+            assert!(best_margin_m < required_m && required_m == 0.5);
+        }
+        other => panic!("expected a step failure, got {other:?}"),
+    }
 }

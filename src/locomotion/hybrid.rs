@@ -26,10 +26,22 @@
 //! `Params::step_cost_factor`).
 //!
 //! **Choices where the paper is silent** (each tested in `locomotion::tests`):
-//! - *Leg reach.* A foot offset is allowed if the sagittal leg IK (`robot::ik::leg_ik`)
-//!   reaches the foot from its hip with the hip at the manoeuvre leg height
-//!   (`Params::manoeuvre_leg_height_m`, 0.45 m) above the foot's ground, level base. This
-//!   gives each leg a fixed offset range, computed once from the model.
+//! - *Leg reach.* A non-neutral footprint is allowed only if the robot can stand in it by
+//!   the leg-height rule of Sec. VI-B that the step motion generator uses
+//!   ([`crate::motion::standing::StandingRule`]): base pitched by 70 % of the slope, its
+//!   height set by the highest foot, the leg height lowered from 0.45 m in 1 cm steps until
+//!   every leg reaches its foot (sagittal IK within the joint limits). A step must in
+//!   addition stay within reach while the foot is carried: the stepping leg counting the
+//!   higher of its grounds, the foot at its swing height above both ends. One rule for
+//!   planner and generator, so no planned footprint stretches a leg the generator cannot.
+//!   Each leg's offset range over all those heights, computed once from the model, bounds
+//!   the scans.
+//! - *Support for a step.* The paper leaves static stability to the step motion
+//!   generator. A plan whose step no alignment can stabilise is useless to it, so a step
+//!   also needs the base centre (about where the CoM projects) inside the support
+//!   triangle of the other three feet, with the partner wheel driven toward the centre as
+//!   far as the generator may (`Params::step_support_margin_m`, 5 cm): roll and a base
+//!   shift align the rest.
 //! - *Which footholds count as a step.* A step must carry the foot *over* untraversable
 //!   terrain: its straight sagittal line crosses at least one cell of infinite foot cost.
 //!   A foothold reachable over finite cells only is a wheel drive (front foot forward /
@@ -40,7 +52,7 @@
 //!   Fig. 5c's "the height difference to overcome" bounds ΔH_step as well (a leg cannot
 //!   lift a foot over a 0.5 m bar even if the far side is level).
 //! - *Non-neutral states* must have all four feet on cells of finite foot cost, a finite
-//!   body cost C_B (eq. 3) with every leg at the manoeuvre leg height (the robot stands
+//!   body cost C_B (eq. 3) with the legs of the standing rule above (the robot stands
 //!   up for manoeuvres, Sec. VI-B), and the two feet of each side at least half the
 //!   support length (`min_support_side_length_m` / 2) apart, so wheel pairs never
 //!   collide. Only neutral states drive.
@@ -59,10 +71,13 @@ use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::geometry::Pose2;
+use crate::motion::kinematics::hips_in_world;
+use crate::motion::standing::StandingRule;
 use crate::params::Params;
 use crate::planner::{Cost, SearchGraph};
 use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
+use crate::stability::stability_margin;
 use serde::Serialize;
 
 /// What an edge of the hybrid graph does.
@@ -158,8 +173,14 @@ pub struct HybridConfig {
     pub max_step_height_m: f64,
     /// Criterion 4: the feet on the non-stepping side must be farther apart, m.
     pub min_support_side_length_m: f64,
-    /// Leg height for manoeuvres (reach and body clearance), m.
-    pub manoeuvre_leg_height_m: f64,
+    /// The leg-height rule for standing manoeuvres (reach and body clearance, Sec. VI-B).
+    pub standing: StandingRule,
+    /// Longest wheel-to-centre move the generator may make for a step, m.
+    pub max_wheel_to_centre_m: f64,
+    /// Gap the displaced wheel pair keeps to the stepping foot, m.
+    pub wheel_gap_m: f64,
+    /// Smallest signed distance of the base centre to a step's support triangle, m.
+    pub step_support_margin_m: f64,
     /// Shortest "front foot forward" move, m (each such move drives as far as it can).
     pub foot_move_increment_m: f64,
     /// Cap on distinct footprints (graph size guard).
@@ -181,7 +202,10 @@ impl HybridConfig {
             step_obstacle_distance_m: params.step_obstacle_distance_m,
             max_step_height_m: params.max_step_height_m,
             min_support_side_length_m: params.min_support_side_length_m,
-            manoeuvre_leg_height_m: params.manoeuvre_leg_height_m,
+            standing: StandingRule::from_params(params),
+            max_wheel_to_centre_m: params.max_wheel_to_centre_m,
+            wheel_gap_m: params.wheel_gap_m,
+            step_support_margin_m: params.step_support_margin_m,
             foot_move_increment_m: 0.1,
             max_footprints: 65_536,
         }
@@ -222,15 +246,11 @@ pub struct HybridGraph<'c> {
     lattice: Lattice,
     /// Neutral foot positions in the base frame (x', y'), FL, FR, RL, RR.
     neutral: [[f64; 2]; 4],
+    /// The robot (leg IK of the standing rule).
+    robot: RobotDescription,
     /// Widest offset range per leg, cells: `[min, max]`, over every leg height a
-    /// manoeuvre can give it (the scan bound; the exact check is [`Self::in_reach`]).
+    /// manoeuvre can give it (the scan bound; the exact check is the standing rule).
     reach: [[i8; 2]; 4],
-    /// Per centimetre of leg height below the manoeuvre height (index 0 = the
-    /// manoeuvre height), per leg, the offsets the leg IK reaches as a bit set (bit
-    /// `o + 64` for offset `o`): the IK solved once here instead of four times per state
-    /// on the search's hot path. A set, not a range: with short legs the foot right under
-    /// the hip needs the knee folded past its limit, while one further forward does not.
-    reach_by_height: Vec<[u128; 4]>,
     footprints: FootprintTable,
     /// Per map cell: an infinite-foot-cost cell lies within the criterion-1 radius plus
     /// half a cell diagonal of its centre (a conservative pre-filter for criterion 1).
@@ -282,17 +302,19 @@ impl<'c> HybridGraph<'c> {
     ) -> Result<Self, LatticeError> {
         let lattice = Lattice::for_map(maps.heights(), orientations)?;
         let res = lattice.resolution;
-        // Leg heights a manoeuvre gives range from the manoeuvre height down to that less
-        // the largest step; take the union of the reach over them, in 1 cm steps.
+        // Level-base leg reach over hip heights from the straight leg down to the driving
+        // height less the largest step, in 1 cm steps: a superset of what the standing
+        // rule admits (pitch below 45° moves a foot less than the leg's full swing).
         let mut union = [0u128; 4];
-        let mut reach_by_height = Vec::new();
-        for cm in 0..=(config.max_step_height_m * 100.0).ceil() as i32 + 1 {
-            let h = config.manoeuvre_leg_height_m - f64::from(cm) * 0.01;
-            let row = Leg::ALL.map(|leg| leg_reach(robot, leg, h, res));
-            for k in 0..4 {
-                union[k] |= row[k];
+        let top = (robot.max_leg_length() * 100.0).ceil() as i32;
+        let low = ((config.standing.min_leg_height_m - config.max_step_height_m) * 100.0)
+            .floor()
+            .max(0.0) as i32;
+        for cm in low..=top {
+            let h = f64::from(cm) * 0.01;
+            for (k, leg) in Leg::ALL.iter().enumerate() {
+                union[k] |= leg_reach(robot, *leg, h, res);
             }
-            reach_by_height.push(row);
         }
         let reach = union.map(bit_range);
         let trig = (0..lattice.orientations).map(|k| lattice.yaw(k as u8).sin_cos()).collect();
@@ -304,8 +326,8 @@ impl<'c> HybridGraph<'c> {
             config,
             lattice,
             neutral: maps.neutral_footprint(),
+            robot: robot.clone(),
             reach,
-            reach_by_height,
             footprints: FootprintTable::new(config.max_footprints),
             trig,
             foot_move_cells,
@@ -438,46 +460,40 @@ impl<'c> HybridGraph<'c> {
         (self.neutral[f][0] + f64::from(o[f]) * res) - (self.neutral[r][0] + f64::from(o[r]) * res)
     }
 
-    /// Leg heights (hip above the foot's ground, m) during a manoeuvre: the base level
-    /// at the manoeuvre leg height above the lowest foot (see the module docs).
-    fn leg_heights(&self, ground: &[f64; 4]) -> [f64; 4] {
-        let low = ground.iter().copied().fold(f64::INFINITY, f64::min);
-        ground.map(|g| self.config.manoeuvre_leg_height_m - (g - low))
+    /// World feet (x, y, ground z) of `feet`.
+    fn feet_xyz(feet: &Feet) -> [[f64; 3]; 4] {
+        std::array::from_fn(|k| [feet.pos[k][0], feet.pos[k][1], feet.h[k]])
     }
 
-    /// Whether leg `k`'s foot at offset `o` (cells) is reachable with the hip `height`
-    /// above its ground (sagittal leg IK, level base): reachable at both neighbouring
-    /// centimetres of the precomputed table, so rounding never admits a pose the IK
-    /// rejects at the table's heights.
-    fn in_reach(&self, k: usize, o: i8, height: f64) -> bool {
-        let below = (self.config.manoeuvre_leg_height_m - height) * 100.0;
-        if !below.is_finite() || below < -1e-9 {
-            return false;
-        }
-        let lo = below.floor().max(0.0) as usize;
-        let hi = below.ceil().max(0.0) as usize;
-        let Ok(bit) = u32::try_from(i32::from(o) + 64) else {
-            return false;
-        };
-        if bit >= 128 {
-            return false;
-        }
-        [lo, hi]
-            .iter()
-            .all(|&r| self.reach_by_height.get(r).is_some_and(|row| row[k] & (1 << bit) != 0))
+    /// Leg heights (hip above the foot's ground, m) of the standing rule for the robot at
+    /// state `s`'s pose on feet `feet`; `None` if no leg height of the rule reaches every
+    /// foot (see the module docs).
+    fn standing_legs(&self, s: LatticeState, feet: &Feet) -> Option<[f64; 4]> {
+        let pose = self.lattice.pose(s);
+        let world = Self::feet_xyz(feet);
+        let (p, _) =
+            self.config.standing.stand(&self.robot, world, [pose.x, pose.y], pose.theta).ok()?;
+        let hips = hips_in_world(&self.robot, &p);
+        Some(std::array::from_fn(|k| hips[k][2] - world[k][2]))
     }
 
-    /// Whether a non-neutral footprint is within reach (feet on `ground`) and keeps the
-    /// wheel pairs apart.
-    fn footprint_ok(&self, o: &FootOffsets, ground: &[f64; 4]) -> bool {
+    /// Whether a non-neutral footprint keeps the wheel pairs apart.
+    fn sides_ok(&self, o: &FootOffsets) -> bool {
         let min_side = 0.5 * self.config.min_support_side_length_m;
-        if self.side_length(o, true) < min_side || self.side_length(o, false) < min_side {
-            return false;
-        }
-        let legs = self.leg_heights(ground);
-        (0..4).all(|k| {
-            (self.reach[k][0]..=self.reach[k][1]).contains(&o[k]) && self.in_reach(k, o[k], legs[k])
-        })
+        self.side_length(o, true) >= min_side && self.side_length(o, false) >= min_side
+    }
+
+    /// Whether the step of leg `leg` from feet `feet` (state `s`) to the foot at
+    /// `post` (x, y, ground z) stays within reach while the foot is carried (the
+    /// standing rule's [`StandingRule::step_heights`]).
+    fn step_in_reach(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
+        let pose = self.lattice.pose(s);
+        let pre = Self::feet_xyz(feet);
+        let rule = &self.config.standing;
+        let swing = rule.swing_z(&self.robot, self.maps.heights(), pre[leg], post);
+        !rule
+            .step_heights(&self.robot, pre, leg, post, [pose.x, pose.y], pose.theta, swing)
+            .is_empty()
     }
 
     /// Whether state `t` (footprint offsets `o`) may be entered; its body cost for
@@ -489,10 +505,14 @@ impl<'c> HybridGraph<'c> {
         let Some(feet) = self.feet_of(t, o) else {
             return false;
         };
-        if !self.footprint_ok(o, &feet.h) {
+        if !self.sides_ok(o)
+            || !(0..4).all(|k| (self.reach[k][0]..=self.reach[k][1]).contains(&o[k]))
+        {
             return false;
         }
-        let legs = self.leg_heights(&feet.h);
+        let Some(legs) = self.standing_legs(t, &feet) else {
+            return false;
+        };
         self.maps.body_cost(&self.lattice.pose(t), &feet.pos, &legs).is_finite()
     }
 
@@ -533,7 +553,9 @@ impl<'c> HybridGraph<'c> {
         let max_d = i32::from(self.reach[leg][1]) - i32::from(o[leg]);
         let mut crossed = false;
         let mut dh_max = 0.0_f64;
-        let mut best: Option<(FootOffsets, StepCost)> = None;
+        // Footholds by the scan: (C_S, offset, cost terms, foothold). The checks that
+        // need the IK run afterwards in order of C_S, and stop at the first that holds.
+        let mut candidates: Vec<(f64, i32, StepCost, [f64; 3])> = Vec::new();
         for d in 1..=max_d {
             let l = f64::from(d) * res;
             let (x, y) = (x0 + hx * l, y0 + hy * l);
@@ -559,17 +581,19 @@ impl<'c> HybridGraph<'c> {
                 continue;
             }
             let c_s = step_cost(&self.config, l, cf, dh_max);
-            if best.as_ref().is_some_and(|(_, b)| b.c_s <= c_s) {
-                continue;
-            }
+            let cost = StepCost { length_m: l, foothold_cost: cf, height_m: dh_max, c_s };
+            candidates.push((c_s, d, cost, [x, y, h]));
+        }
+        // Cheapest first; ties: the shorter step (the scan order, kept by a stable sort).
+        candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+        candidates.into_iter().find_map(|(_, d, cost, foothold)| {
             let mut o2 = *o;
             o2[leg] = (i32::from(o[leg]) + d) as i8;
-            if !self.target_ok(s, &o2) {
-                continue;
-            }
-            best = Some((o2, StepCost { length_m: l, foothold_cost: cf, height_m: dh_max, c_s }));
-        }
-        best
+            (self.step_supported(s, feet, leg, foothold)
+                && self.target_ok(s, &o2)
+                && self.step_in_reach(s, feet, leg, foothold))
+            .then_some((o2, cost))
+        })
     }
 
     /// Mean foot cost along a wheel pair's straight drive of `cells` cells from `p` in
@@ -641,9 +665,8 @@ impl<'c> HybridGraph<'c> {
         // Longitudinal base shift: both front feet ahead of neutral; forward until a
         // front foot is neutral or a rear leg is at the end of its reach.
         if o[0] > 0 && o[1] > 0 {
-            let legs = self.leg_heights(&feet.h);
             let mut l = o[0].min(o[1]);
-            while l > 0 && ![2, 3].iter().all(|&r| self.in_reach(r, o[r] - l, legs[r])) {
+            while l > 0 && !self.shift_in_reach(s, &feet, l) {
                 l -= 1;
             }
             if l > 0 {
@@ -749,12 +772,68 @@ impl<'c> HybridGraph<'c> {
         }
     }
 
+    /// Whether the base centre of state `s` lies in the support triangle of a step of
+    /// `leg` to `post` (x, y) with at least `step_support_margin_m`: the triangle of the
+    /// other three feet, the partner on the stepping side driven toward the centre as far
+    /// as the generator may (`max_wheel_to_centre_m`, keeping `wheel_gap_m` to the
+    /// stepping foot at both ends, stopping before untraversable cells and height
+    /// changes), as in Sec. VI-A. The CoM projects near the base centre (up to about 5 cm
+    /// behind it with the base pitched on stairs, which the margin covers); roll and a base
+    /// shift align the rest.
+    fn step_supported(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
+        let p = self.lattice.pose(s);
+        let (hx, hy) = self.heading(s.theta);
+        let along = |q: [f64; 2]| (q[0] - p.x) * hx + (q[1] - p.y) * hy;
+        let partner = Leg::ALL[leg].same_side_partner().index();
+        let pj = feet.pos[partner];
+        let (ai, ap) = (along(feet.pos[leg]), along([post[0], post[1]]));
+        let aj = along(pj);
+        let c = &self.config;
+        // Toward the centre: a front partner moves back, a rear one forward.
+        let d = if partner < 2 {
+            (aj - (ai.max(ap) + c.wheel_gap_m)).clamp(0.0, c.max_wheel_to_centre_m)
+        } else {
+            ((ai.min(ap) - c.wheel_gap_m) - aj).clamp(0.0, c.max_wheel_to_centre_m)
+        };
+        let sign = if partner < 2 { -1.0 } else { 1.0 };
+        // The wheels stop, as the generator's do, before untraversable cells and height
+        // changes of 2 cm.
+        let res = self.lattice.resolution;
+        let hj = feet.h[partner];
+        let mut moved_d = 0.0;
+        while moved_d + res <= d + 1e-9 {
+            let e = moved_d + res;
+            match self.cell(pj[0] + sign * e * hx, pj[1] + sign * e * hy) {
+                Ok((_, h)) if (h - hj).abs() < 0.02 => moved_d = e,
+                _ => break,
+            }
+        }
+        let moved = [pj[0] + sign * moved_d * hx, pj[1] + sign * moved_d * hy];
+        let support: Vec<[f64; 2]> = (0..4)
+            .filter(|&k| k != leg)
+            .map(|k| if k == partner { moved } else { feet.pos[k] })
+            .collect();
+        stability_margin(&support, [p.x, p.y]) >= c.step_support_margin_m
+    }
+
+    /// Whether the robot can stand by the rule with its base `l` cells ahead of state
+    /// `s`'s pose, over the same feet.
+    fn shift_in_reach(&self, s: LatticeState, feet: &Feet, l: i8) -> bool {
+        let p = self.lattice.pose(s);
+        let (hx, hy) = self.heading(s.theta);
+        let d = f64::from(l) * self.lattice.resolution;
+        let xy = [p.x + hx * d, p.y + hy * d];
+        self.config.standing.stand(&self.robot, Self::feet_xyz(feet), xy, p.theta).is_ok()
+    }
+
     /// A base shift by `l` cells over the standing feet (see the module docs).
     fn push_base_shift(&mut self, s: LatticeState, o: &FootOffsets, feet: &Feet, l: i8) {
         let res = self.lattice.resolution;
         let (hx, hy) = self.heading(s.theta);
         let p = self.lattice.pose(s);
-        let legs = self.leg_heights(&feet.h);
+        let Some(legs) = self.standing_legs(s, feet) else {
+            return;
+        };
         // C_B,avg: the body cost at every cell-length of the shift, feet fixed in the world.
         let mut sum = 0.0;
         for k in 0..=l {

@@ -401,16 +401,35 @@ mod hybrid {
             .into_iter()
             .find(|(_, _, m)| m.kind == ManoeuvreKind::BaseShift)
             .expect("base shift");
-        // Until a rear leg (rear feet on the ground, 0.45 m legs) reaches −0.42 m:
-        // 16 cells, 0.4 m.
-        assert_eq!(g.offsets(t), Some([3, 3, -16, -16]));
-        assert_eq!(t.i - s.i, 16);
-        assert!((m.length_m - 0.4).abs() < 1e-9);
+        // Until the rear legs, stretched back over the floor, are at the end of their reach
+        // by the standing rule (Sec. VI-B: base pitched 70 % of the slope, its height set
+        // by the front feet on the platform): the robot can stand at the shift's end and
+        // not one cell further.
+        let o = g.offsets(t).expect("interned");
+        let l = i32::from(o[0]) - 19;
+        assert!(l < 0 && o == [o[0], o[0], l as i8, l as i8], "{o:?}");
+        assert_eq!(i32::from(t.i - s.i), -l);
+        assert!((m.length_m - f64::from(-l) * 0.025).abs() < 1e-9);
+        let robot = RobotDescription::reference();
+        let rule = crate::motion::StandingRule::from_params(&Params::default());
+        let stands = |cells: i32| {
+            let base = 0.48 + f64::from(s.i - state_at(&g, 0.48, 0.0).i) * 0.025;
+            let x = base + f64::from(cells) * 0.025;
+            let feet = [
+                [base + 0.35 + 0.475, 0.32, 0.2],
+                [base + 0.35 + 0.475, -0.32, 0.2],
+                [base - 0.35, 0.32, 0.0],
+                [base - 0.35, -0.32, 0.0],
+            ];
+            rule.stand(&robot, feet, [x, 0.0], 0.0).is_ok()
+        };
+        assert!(stands(-l) && !stands(-l + 1), "shift of {} cells", -l);
         // C_B,avg = 1 + k3 · 0.2 = 1.1 (front feet 0.2 m higher; the legs are long
-        // enough that the base clears everything): C_BS = 0.5 · 0.4 · 1.1 = 0.22.
+        // enough that the base clears everything): C_BS = 0.5 · L · 1.1.
         let f = Params::default().step_cost_factor;
-        assert!((m.cost - f * 0.22).abs() < 1e-9, "{m:?}");
-        assert_eq!(c, Cost::from_f64_ceil(f * 0.22 * (1.0 - 1e-12)));
+        let c_bs = 0.5 * m.length_m * 1.1;
+        assert!((m.cost - f * c_bs).abs() < 1e-9, "{m:?}");
+        assert_eq!(c, Cost::from_f64_ceil(f * c_bs * (1.0 - 1e-12)));
     }
 
     #[test]

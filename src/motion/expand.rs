@@ -26,13 +26,13 @@
 //!   the CoM's, stopping before cells of infinite foot cost, height changes, and
 //!   [`MotionOptions::wheel_gap_m`] from the stepping foot), `base_shift` (only if a
 //!   longitudinal error of more than 2 cm remains: the wheel was blocked), `lift` (the
-//!   foot rises vertically to [`MotionOptions::swing_clearance_m`] above the highest
+//!   foot rises vertically to `StandingRule::swing_clearance_m` above the highest
 //!   terrain within a wheel's reach of its straight path), `swing`, `place`, then
 //!   `shift_back`, `wheel_back`, `roll_back` (to the post-step pitch).
 //!
 //! **Stability** (Sec. VI-A): every keyframe and interpolated point (every 1 cm of base or
 //! foot motion and every 0.02 rad) is solved with the leg IK (reach with
-//! [`MotionOptions::reach_margin_m`] to spare, joint limits) and its CoM computed with the
+//! `StandingRule::reach_margin_m` to spare, joint limits) and its CoM computed with the
 //! [`CenterOfMassModel`]; its margin in the support polygon of the feet in contact must be
 //! at least [`MotionOptions::min_margin_m`] (default 3 cm).
 //!
@@ -48,6 +48,7 @@ use super::keyframe::{DetailedPath, Keyframe, Phase};
 use super::kinematics;
 use super::kinematics::{Evaluation, Posture, contacts_in_base, evaluate, interpolate, rotation};
 use super::roll::roll_for_lateral_com;
+use super::standing::{StandingRule, base_z};
 use crate::cost::CostMaps;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::jobs::plan::{PathElement, PathKind};
@@ -59,16 +60,10 @@ use crate::robot::{Leg, RobotDescription};
 pub struct MotionOptions {
     /// Minimum static stability margin at every keyframe and interpolated point, m.
     pub min_margin_m: f64,
-    /// Soft minimum leg height while standing (Sec. VI-B), m.
-    pub manoeuvre_leg_height_m: f64,
+    /// The standing leg-height rule (Sec. VI-B), the one the planner checks reach with.
+    pub standing: StandingRule,
     /// Driving leg height (Sec. VI-B), m.
     pub driving_leg_height_m: f64,
-    /// Base pitch as a fraction of the ground slope (Sec. VI-B).
-    pub pitch_fraction: f64,
-    /// Spare reach every leg keeps (hip-to-ankle below thigh + shin by this much), m.
-    pub reach_margin_m: f64,
-    /// Swing foot clearance above the terrain near its path, m.
-    pub swing_clearance_m: f64,
     /// Largest base roll, rad.
     pub max_roll_rad: f64,
     /// Largest stabilising base shift, m.
@@ -96,15 +91,12 @@ impl MotionOptions {
     pub fn from_params(params: &Params) -> Self {
         Self {
             min_margin_m: params.min_stability_margin_m,
-            manoeuvre_leg_height_m: params.manoeuvre_leg_height_m,
+            standing: StandingRule::from_params(params),
             driving_leg_height_m: params.driving_leg_height_m,
-            pitch_fraction: params.base_pitch_slope_fraction,
-            reach_margin_m: 0.002,
-            swing_clearance_m: 0.05,
-            max_roll_rad: 0.15,
+            max_roll_rad: 0.2,
             max_base_shift_m: 0.2,
-            max_wheel_to_centre_m: 0.45,
-            wheel_gap_m: 0.3,
+            max_wheel_to_centre_m: params.max_wheel_to_centre_m,
+            wheel_gap_m: params.wheel_gap_m,
             stay_standing_m: 1.0,
             sample_m: 0.01,
             sample_rad: 0.02,
@@ -218,7 +210,7 @@ impl Expander<'_> {
 
     /// Base pitch: `pitch_fraction` of the slope between the front and rear feet.
     fn pitch_for(&self, feet: &[[f64; 3]; 4], yaw: f64) -> f64 {
-        kinematics::pitch_from_feet(feet, yaw, self.o.pitch_fraction)
+        self.o.standing.pitch(feet, yaw)
     }
 
     /// Driving posture at `pose` (Sec. VI-B, [`kinematics::driving_posture`]).
@@ -227,7 +219,7 @@ impl Expander<'_> {
             self.robot,
             pose,
             self.o.driving_leg_height_m,
-            self.o.pitch_fraction,
+            self.o.standing.pitch_fraction,
             |x, y| self.maps.height_at(x, y),
         )
         .map_err(|[x, y]| MotionError::UnknownTerrain { index: self.index, x, y })
@@ -252,14 +244,7 @@ impl Expander<'_> {
         let r = rotation(rpy);
         let mut p = Posture { base_position: [xy[0], xy[1], 0.0], base_rpy: rpy, feet, contact };
         for _ in 0..3 {
-            let z = (0..4)
-                .map(|i| {
-                    let h = self.robot.hips[i];
-                    let dz = r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2];
-                    ground[i] + height - dz
-                })
-                .fold(f64::NEG_INFINITY, f64::max);
-            p.base_position[2] = z;
+            p.base_position[2] = base_z(self.robot, &ground, rpy, height);
             let local = contacts_in_base(self.robot, &p);
             let n = contact.iter().filter(|&&c| c).count().max(1) as f64;
             let m = (0..4).filter(|&i| contact[i]).map(|i| local[i][1]).sum::<f64>() / n;
@@ -278,31 +263,23 @@ impl Expander<'_> {
         p
     }
 
-    /// A standing posture for all four feet in contact, lowering the leg height from the
-    /// manoeuvre height in 1 cm steps until every leg reaches (Sec. VI-B soft constraint).
+    /// The standing posture of the shared rule ([`StandingRule::stand`]) for all four
+    /// feet in contact.
     fn standing_fallback(
         &mut self,
         feet: [[f64; 3]; 4],
         xy: [f64; 2],
         yaw: f64,
     ) -> Result<Posture, String> {
-        let pitch = self.pitch_for(&feet, yaw);
-        let ground = feet.map(|f| f[2]);
-        let mut h = self.o.manoeuvre_leg_height_m;
-        let mut last = String::new();
-        while h >= self.o.driving_leg_height_m - 1e-9 {
-            let p = self.standing(feet, [true; 4], xy, yaw, pitch, 0.0, h, ground);
-            match evaluate(self.robot, self.model, &p, self.o.reach_margin_m) {
-                Ok(_) => return Ok(p),
-                Err(e) => last = e.to_string(),
-            }
-            h -= 0.01;
-        }
-        Err(format!("no standing leg height reaches every foot: {last}"))
+        self.o
+            .standing
+            .stand(self.robot, feet, xy, yaw)
+            .map(|(p, _)| p)
+            .map_err(|e| format!("no standing leg height reaches every foot: {e}"))
     }
 
     fn com_of(&mut self, p: &Posture) -> Result<[f64; 3], String> {
-        evaluate(self.robot, self.model, p, self.o.reach_margin_m)
+        evaluate(self.robot, self.model, p, self.o.standing.reach_margin_m)
             .map(|e| e.com)
             .map_err(|e| e.to_string())
     }
@@ -340,7 +317,7 @@ impl Expander<'_> {
                     *f = [w[0], w[1], z];
                 }
             }
-            let e = evaluate(self.robot, self.model, &p, o.reach_margin_m)
+            let e = evaluate(self.robot, self.model, &p, o.standing.reach_margin_m)
                 .map_err(|e| format!("at {:.0} % of the segment: {e}", t * 100.0))?;
             if e.margin < o.min_margin_m {
                 return Err(format!(
@@ -443,30 +420,6 @@ impl Expander<'_> {
         [self.cur.base_position[0], self.cur.base_position[1]]
     }
 
-    /// Highest terrain within `radius` of the segment `a`–`b`, m.
-    fn max_height_near(&self, a: [f64; 3], b: [f64; 3], radius: f64) -> f64 {
-        let res = self.maps.heights().resolution();
-        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
-        let n = (len / (res / 2.0)).ceil().max(1.0) as usize;
-        let r = (radius / res).ceil() as i64;
-        let mut best = a[2].max(b[2]);
-        for s in 0..=n {
-            let t = s as f64 / n as f64;
-            let (x, y) = (a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t);
-            for dj in -r..=r {
-                for di in -r..=r {
-                    let (dx, dy) = (di as f64 * res, dj as f64 * res);
-                    if dx.hypot(dy) <= radius + 1e-9
-                        && let Some(h) = self.maps.height_at(x + dx, y + dy)
-                    {
-                        best = best.max(h);
-                    }
-                }
-            }
-        }
-        best
-    }
-
     /// Builds the keyframes of one step candidate.
     fn step_candidate(
         &mut self,
@@ -475,7 +428,7 @@ impl Expander<'_> {
         height: f64,
         wheel_fraction: f64,
         roll_fraction: f64,
-        shift_fraction: f64,
+        shift: Shift,
     ) -> Result<Vec<Planned>, String> {
         let o = self.o.clone();
         let i = leg.index();
@@ -487,7 +440,7 @@ impl Expander<'_> {
         let pre = self.cur.feet;
         let mut post = pre;
         post[i] = post_foot;
-        let pitch = (self.pitch_for(&pre, yaw) + self.pitch_for(&post, yaw)) / 2.0;
+        let pitch = self.o.standing.step_pitch(&pre, &post, yaw);
         let pitch_post = self.pitch_for(&post, yaw);
         let mut ground = pre.map(|f| f[2]);
         ground[i] = pre[i][2].max(post_foot[2]);
@@ -558,19 +511,21 @@ impl Expander<'_> {
         // Only when the wheel could not go as far as alignment wanted (blocked, or a
         // candidate with a shorter wheel move).
         let hindered = d + 1e-3 < wanted;
-        let shift = {
-            let rem = along(stc) - along(com);
-            if hindered && rem.abs() > 0.02 {
-                shift_fraction * rem.clamp(-o.max_base_shift_m, o.max_base_shift_m)
-            } else {
-                0.0
+        let shift = match shift {
+            Shift::Remainder(fraction) => {
+                let rem = along(stc) - along(com);
+                if hindered && rem.abs() > 0.02 {
+                    fraction * rem.clamp(-o.max_base_shift_m, o.max_base_shift_m)
+                } else {
+                    0.0
+                }
             }
+            Shift::Fixed(m) => m.clamp(-o.max_base_shift_m, o.max_base_shift_m),
         };
         let xy_shift = [xy[0] + shift * c, xy[1] + shift * s];
 
         // Swing height.
-        let radius = self.robot.wheel_radius + self.robot.wheel_track / 2.0 + 0.02;
-        let swing_z = self.max_height_near(pre[i], post_foot, radius) + o.swing_clearance_m;
+        let swing_z = self.o.standing.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
         let mut lift_feet = moved;
         lift_feet[i] = [pre[i][0], pre[i][1], swing_z];
         let mut swing_feet = moved;
@@ -612,48 +567,56 @@ impl Expander<'_> {
 
     fn expand_step(&mut self, leg: Leg, post_xy: [f64; 2]) -> Result<(), MotionError> {
         let post_foot = [post_xy[0], post_xy[1], self.ground(post_xy[0], post_xy[1])?];
-        let base_h = self.o.manoeuvre_leg_height_m;
-        let mut heights = vec![base_h];
-        let mut h = base_h - 0.025;
-        while h >= self.o.driving_leg_height_m - 1e-9 {
-            heights.push(h);
-            h -= 0.025;
+        // The heights of the shared rule at which the step is within reach (what the
+        // planner checked), then two taller stances (the soft constraint is a minimum).
+        let i = leg.index();
+        let (pre, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
+        let rule = self.o.standing;
+        let swing_z = rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
+        let mut heights = rule.step_heights(self.robot, pre, i, post_foot, xy, yaw, swing_z);
+        heights.extend([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1]);
+        // First the paper's sequence (a base shift only where the wheel was hindered), in
+        // full, half or none of each alignment; then base shifts of fixed length with
+        // every wheel and roll choice (the CoM may need to go where the wheel cannot
+        // take the support triangle, e.g. sideways out of a narrow triangle).
+        let mut candidates = Vec::new();
+        for pass in 0..2 {
+            for &h in &heights {
+                for wf in [1.0, 0.5, 0.0] {
+                    for rf in [1.0, 0.5, 0.0] {
+                        if pass == 0 {
+                            for f in [1.0, 0.5, 0.0] {
+                                candidates.push((h, wf, rf, Shift::Remainder(f)));
+                            }
+                        } else {
+                            for m in [0.05, 0.1, 0.15, 0.2, -0.05, -0.1, -0.15, -0.2] {
+                                candidates.push((h, wf, rf, Shift::Fixed(m)));
+                            }
+                        }
+                    }
+                }
+            }
         }
-        heights.extend([base_h + 0.05, base_h + 0.1]);
         let mut best: (f64, String) = (f64::NEG_INFINITY, "no candidate".to_owned());
-        for &h in &heights {
-            for &wf in &[1.0, 0.5, 0.0] {
-                for (rf, shift) in [
-                    (1.0, 1.0),
-                    (1.0, 0.5),
-                    (1.0, 0.0),
-                    (0.5, 1.0),
-                    (0.5, 0.5),
-                    (0.5, 0.0),
-                    (0.0, 1.0),
-                    (0.0, 0.5),
-                    (0.0, 0.0),
-                ] {
-                    let seq = match self.step_candidate(leg, post_foot, h, wf, rf, shift) {
-                        Ok(s) => s,
-                        Err(e) => {
-                            if best.0 == f64::NEG_INFINITY {
-                                best.1 = e;
-                            }
-                            continue;
-                        }
-                    };
-                    match self.trial(&seq) {
-                        Ok((k, mm, m3, s)) => {
-                            self.commit(k, mm, m3, s);
-                            return Ok(());
-                        }
-                        Err(e) => {
-                            let m = margin_in(&e);
-                            if m > best.0 || best.0 == f64::NEG_INFINITY {
-                                best = (m, e);
-                            }
-                        }
+        for (h, wf, rf, shift) in candidates {
+            let seq = match self.step_candidate(leg, post_foot, h, wf, rf, shift) {
+                Ok(s) => s,
+                Err(e) => {
+                    if best.0 == f64::NEG_INFINITY {
+                        best.1 = e;
+                    }
+                    continue;
+                }
+            };
+            match self.trial(&seq) {
+                Ok((k, mm, m3, s)) => {
+                    self.commit(k, mm, m3, s);
+                    return Ok(());
+                }
+                Err(e) => {
+                    let m = margin_in(&e);
+                    if m > best.0 || best.0 == f64::NEG_INFINITY {
+                        best = (m, e);
                     }
                 }
             }
@@ -666,6 +629,15 @@ impl Expander<'_> {
             reason: best.1,
         })
     }
+}
+
+/// The longitudinal base shift of a step candidate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Shift {
+    /// This fraction of the CoM–STC remainder, only when the wheel was hindered (Sec. VI-A).
+    Remainder(f64),
+    /// A fixed shift, m (forward positive).
+    Fixed(f64),
 }
 
 /// The margin quoted in a failure message, −inf if none.
@@ -711,7 +683,7 @@ pub fn expand_path(
     };
     let start = ex.driving(&first.pose)?;
     ex.cur = start;
-    let e = evaluate(robot, ex.model, &start, options.reach_margin_m)
+    let e = evaluate(robot, ex.model, &start, options.standing.reach_margin_m)
         .map_err(|e| MotionError::Manoeuvre { index: 0, kind: "start", reason: e.to_string() })?;
     ex.min_margin = e.margin;
     ex.samples = 1;
@@ -796,7 +768,13 @@ pub fn expand_path(
                         steps += 1;
                     }
                     (PathKind::BaseShift, _) => {
-                        let feet = ex.cur.feet;
+                        // The planner's shift ends on a lattice cell, so its feet stand up
+                        // to half a cell from where they were: take its footprint (the
+                        // wheels roll that far), so both agree on every later reach.
+                        let mut feet = ex.cur.feet;
+                        for (f, p) in feet.iter_mut().zip(el.feet) {
+                            *f = [p[0], p[1], ex.ground(p[0], p[1])?];
+                        }
                         let p = ex
                             .standing_fallback(feet, [el.pose.x, el.pose.y], el.pose.theta)
                             .map_err(bad)?;

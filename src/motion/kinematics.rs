@@ -71,6 +71,9 @@ pub enum PostureError {
         /// Required spare reach, m.
         margin: f64,
     },
+    /// The standing rule has no leg height to try.
+    #[error("no leg height to try")]
+    NoHeight,
     /// A foot in contact lies too far from its leg's sagittal plane.
     #[error("leg {leg:?}: contact {offset:.3} m off the leg plane")]
     Lateral {
@@ -123,20 +126,17 @@ pub fn hips_in_world(robot: &RobotDescription, p: &Posture) -> [[f64; 3]; 4] {
     std::array::from_fn(|i| apply(&r, p.base_position, robot.hips[i]))
 }
 
-/// Solves the legs of `p`, computes the CoM with `model` and the stability margin of the
-/// feet in contact.
+/// Solves the legs of `p`: joint targets (hip, knee, ankle) per leg.
 ///
 /// # Errors
 /// [`PostureError`] if a leg cannot reach its foot with `reach_margin` m to spare, a joint
 /// limit is passed, or a foot in contact lies off its leg plane.
-pub fn evaluate(
+pub fn solve_legs(
     robot: &RobotDescription,
-    model: &mut dyn CenterOfMassModel,
     p: &Posture,
     reach_margin: f64,
-) -> Result<Evaluation, PostureError> {
+) -> Result<[[f64; 3]; 4], PostureError> {
     let local = contacts_in_base(robot, p);
-    let hips = hips_in_world(robot, p);
     let pitch = p.base_rpy[1];
     let below = robot.foot_length + robot.wheel_radius;
     let reach = robot.thigh_length + robot.shin_length;
@@ -155,6 +155,22 @@ pub fn evaluate(
         }
         joints[i] = leg_ik(robot, leg, [c[0], c[2]], pitch)?;
     }
+    Ok(joints)
+}
+
+/// Solves the legs of `p` ([`solve_legs`]), computes the CoM with `model` and the
+/// stability margin of the feet in contact.
+///
+/// # Errors
+/// [`PostureError`] as [`solve_legs`].
+pub fn evaluate(
+    robot: &RobotDescription,
+    model: &mut dyn CenterOfMassModel,
+    p: &Posture,
+    reach_margin: f64,
+) -> Result<Evaluation, PostureError> {
+    let joints = solve_legs(robot, p, reach_margin)?;
+    let hips = hips_in_world(robot, p);
     let leg_heights = std::array::from_fn(|i| hips[i][2] - p.feet[i][2]);
     let com = model.com(p.base_position, p.base_rpy, &joints);
     let support: Vec<[f64; 2]> =

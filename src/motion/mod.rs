@@ -5,6 +5,8 @@
 //! - [`roll`]: the base roll of eqs. 6–8 (lateral CoM alignment), a pure function.
 //! - [`kinematics`]: a whole-robot posture (base pose, feet, contacts) → leg IK, leg
 //!   heights, CoM (through [`CenterOfMassModel`]) and the static stability margin.
+//! - [`standing`]: the Sec. VI-B leg-height rule for standing manoeuvres, shared with the
+//!   planner's reach checks so planner and generator agree on what a footprint can reach.
 //! - [`keyframe`]: [`Keyframe`], [`Phase`], [`DetailedPath`] (serialisable).
 //! - [`expand`]: [`expand_path`], the expansion itself (see its docs for every manoeuvre).
 //!
@@ -16,11 +18,13 @@ pub mod expand;
 pub mod keyframe;
 pub mod kinematics;
 pub mod roll;
+pub mod standing;
 
 pub use expand::{MotionError, MotionOptions, expand_path};
 pub use keyframe::{DetailedPath, Keyframe, Phase};
 pub use kinematics::{Evaluation, Posture, rotation};
 pub use roll::{RollError, RollSolution, roll_for_lateral_com};
+pub use standing::StandingRule;
 
 use crate::robot::RobotDescription;
 use crate::robot::ik::leg_fk;

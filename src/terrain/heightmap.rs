@@ -304,6 +304,43 @@ impl HeightMap {
         self.get(i, j)
     }
 
+    /// Highest known terrain over the cells whose centres lie within `radius` of the
+    /// segment from `a` to `b` (x, y; the ends' z count too), m: what a foot carried along
+    /// the segment must clear.
+    pub fn max_height_near_segment(&self, a: [f64; 3], b: [f64; 3], radius: f64) -> f64 {
+        let mut best = a[2].max(b[2]);
+        let res = self.resolution;
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = dx * dx + dy * dy;
+        let r2 = radius * radius;
+        let lo = |v: f64, o: f64| (((v - radius - o) / res).floor().max(0.0)) as usize;
+        let hi = |v: f64, o: f64, n: usize| {
+            ((((v + radius - o) / res).floor()).max(-1.0) as i64).min(n as i64 - 1)
+        };
+        let (i0, j0) = (lo(a[0].min(b[0]), self.origin[0]), lo(a[1].min(b[1]), self.origin[1]));
+        let i1 = hi(a[0].max(b[0]), self.origin[0], self.nx);
+        let j1 = hi(a[1].max(b[1]), self.origin[1], self.ny);
+        for j in j0 as i64..=j1 {
+            for i in i0 as i64..=i1 {
+                let (i, j) = (i as usize, j as usize);
+                let [cx, cy] = self.cell_center(i, j);
+                // Squared distance from the cell centre to the segment.
+                let t = if len2 > 0.0 {
+                    (((cx - a[0]) * dx + (cy - a[1]) * dy) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (ex, ey) = (a[0] + t * dx - cx, a[1] + t * dy - cy);
+                if ex * ex + ey * ey <= r2
+                    && let Some(h) = self.get(i, j)
+                {
+                    best = best.max(h);
+                }
+            }
+        }
+        best
+    }
+
     /// Bilinear interpolation between the four cell centres around (x, y).
     ///
     /// `None` if a needed corner is unknown or outside the map; a corner whose weight is
@@ -421,6 +458,35 @@ impl<'a> HeightMapView<'a> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn max_height_near_a_segment_by_hand() {
+        // 10 × 10 cells of 0.1 m from (0, 0); a 0.3 m wall at x ∈ [0.6, 0.7) and a 0.5 m
+        // post at cell (2, 8).
+        let hm = HeightMap::from_fn([0.0, 0.0], 0.1, 10, 10, |i, j| {
+            if i == 6 {
+                0.3
+            } else if (i, j) == (2, 8) {
+                0.5
+            } else {
+                0.0
+            }
+        })
+        .unwrap();
+        // Along y = 0.25 from x = 0.1 to 0.45: the wall's centres (x = 0.65) lie 0.2 away.
+        let seg =
+            |bx: f64, r: f64| hm.max_height_near_segment([0.1, 0.25, 0.0], [bx, 0.25, 0.0], r);
+        assert_eq!(seg(0.45, 0.15), 0.0);
+        assert_eq!(seg(0.45, 0.21), 0.3);
+        // Through the wall.
+        assert_eq!(seg(0.9, 0.01), 0.3);
+        // The post at (0.25, 0.85) is 0.6 from the segment: only a wide radius sees it.
+        assert_eq!(seg(0.45, 0.59), 0.3);
+        assert_eq!(seg(0.45, 0.61), 0.5);
+        // The ends' own heights count; off the map nothing is seen.
+        assert_eq!(hm.max_height_near_segment([5.0, 5.0, 0.1], [6.0, 5.0, 0.2], 0.3), 0.2);
+    }
+
     use super::*;
 
     fn ramp_map() -> HeightMap {

@@ -1,0 +1,401 @@
+//! The leg-height rule for standing manoeuvres (Sec. VI-B), shared by the planner's
+//! reach checks (`locomotion::hybrid`) and the step motion generator (`motion::expand`),
+//! so every footprint the planner admits is one the generator can stand in.
+//!
+//! Sec. VI-B: for manoeuvres other than driving, "the base height is determined by the
+//! highest foot. A soft constraint is applied that the leg height should be at least
+//! 0.45 m. At the same time, a hard constraint […] is that none of the legs exceeds its
+//! maximum leg length", and "the robot base pitching angle is set to be 70 % of the ground
+//! slope". Here:
+//!
+//! - the pitch is `pitch_fraction` of the slope between the mean front and mean rear foot
+//!   ([`super::kinematics::pitch_from_feet`]); during a step, the mean of the pitch before
+//!   and after it;
+//! - the base origin is raised until the leg over the highest ground is `height` long (the
+//!   others are longer);
+//! - `height` starts at the soft constraint (0.45 m) and drops in 1 cm steps, down to the
+//!   driving height, until every leg reaches its foot with the reach margin to spare
+//!   (sagittal IK within the joint limits, [`super::kinematics::solve_legs`]);
+//! - during a step, the stepping leg counts the higher of its two grounds (the foot must
+//!   clear it), and its foot must also be reachable at the swing height above both ends.
+
+use super::kinematics::{Posture, PostureError, apply, pitch_from_feet, rotation, solve_legs};
+use crate::params::Params;
+use crate::robot::RobotDescription;
+use crate::terrain::HeightMap;
+
+/// The parameters of the rule.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StandingRule {
+    /// Soft minimum leg height of the highest foot (0.45 m, Sec. VI-B), m.
+    pub leg_height_m: f64,
+    /// Lowest leg height tried (the driving height, 0.27 m), m.
+    pub min_leg_height_m: f64,
+    /// Decrement between tried heights, m.
+    pub height_step_m: f64,
+    /// Base pitch as a fraction of the ground slope (0.7, Sec. VI-B).
+    pub pitch_fraction: f64,
+    /// Spare reach every leg keeps (hip-to-ankle below thigh + shin by this much), m.
+    pub reach_margin_m: f64,
+    /// Swing foot clearance above the terrain near its path, m.
+    pub swing_clearance_m: f64,
+}
+
+impl StandingRule {
+    /// The paper's values from `params`, 1 cm height steps, 2 mm spare reach, 5 cm swing
+    /// clearance.
+    pub fn from_params(params: &Params) -> Self {
+        Self {
+            leg_height_m: params.manoeuvre_leg_height_m,
+            min_leg_height_m: params.driving_leg_height_m,
+            height_step_m: 0.01,
+            pitch_fraction: params.base_pitch_slope_fraction,
+            reach_margin_m: 0.002,
+            swing_clearance_m: 0.05,
+        }
+    }
+
+    /// Swing height of a foot carried from `a` to `b`: `swing_clearance_m` above the
+    /// highest terrain within a wheel pair's half-width (plus 2 cm) of its straight path.
+    pub fn swing_z(
+        &self,
+        robot: &RobotDescription,
+        heights: &HeightMap,
+        a: [f64; 3],
+        b: [f64; 3],
+    ) -> f64 {
+        let radius = robot.wheel_radius + robot.wheel_track / 2.0 + 0.02;
+        heights.max_height_near_segment(a, b, radius) + self.swing_clearance_m
+    }
+
+    /// The heights tried, soft constraint first.
+    pub fn heights(&self) -> impl Iterator<Item = f64> + use<> {
+        let (top, low, step) = (self.leg_height_m, self.min_leg_height_m, self.height_step_m);
+        let n =
+            if step > 0.0 && top >= low { ((top - low) / step + 1e-9).floor() as usize } else { 0 };
+        (0..=n).map(move |k| top - k as f64 * step)
+    }
+
+    /// Pitch for feet `feet` under heading `yaw`.
+    pub fn pitch(&self, feet: &[[f64; 3]; 4], yaw: f64) -> f64 {
+        pitch_from_feet(feet, yaw, self.pitch_fraction)
+    }
+
+    /// Pitch during a step from feet `pre` to feet `post`: the mean of both.
+    pub fn step_pitch(&self, pre: &[[f64; 3]; 4], post: &[[f64; 3]; 4], yaw: f64) -> f64 {
+        (self.pitch(pre, yaw) + self.pitch(post, yaw)) / 2.0
+    }
+
+    /// The first height of [`Self::heights`] at which all four feet (in contact, on their
+    /// legs' planes) are reached, with the posture.
+    ///
+    /// # Errors
+    /// The last height's [`PostureError`] if none reaches.
+    pub fn stand(
+        &self,
+        robot: &RobotDescription,
+        feet: [[f64; 3]; 4],
+        xy: [f64; 2],
+        yaw: f64,
+    ) -> Result<(Posture, f64), PostureError> {
+        let pitch = self.pitch(&feet, yaw);
+        let ground = feet.map(|f| f[2]);
+        let probe = ReachProbe::new(robot, &feet, [true; 4], xy, [0.0, pitch, yaw], &ground, self);
+        let mut last = None;
+        for h in self.heights() {
+            if let Err(e) = probe.distances_ok(h) {
+                last = Some(e);
+                continue;
+            }
+            let p = level_posture(robot, feet, [true; 4], xy, [0.0, pitch, yaw], h, ground);
+            match solve_legs(robot, &p, self.reach_margin_m) {
+                Ok(_) => return Ok((p, h)),
+                Err(e) => last = Some(e),
+            }
+        }
+        Err(last.unwrap_or(PostureError::NoHeight))
+    }
+
+    /// The heights of [`Self::heights`] at which a step of leg `leg` from feet `pre` to
+    /// `post_foot` keeps every leg within reach: the three support feet and the stepping
+    /// foot on the ground at both ends and at `swing_z` along its straight path (every 5 cm,
+    /// ends included: a folded leg cannot pass under its hip), with the step's
+    /// pitch and the stepping leg counting the higher ground.
+    #[allow(clippy::too_many_arguments)]
+    pub fn step_heights(
+        &self,
+        robot: &RobotDescription,
+        pre: [[f64; 3]; 4],
+        leg: usize,
+        post_foot: [f64; 3],
+        xy: [f64; 2],
+        yaw: f64,
+        swing_z: f64,
+    ) -> Vec<f64> {
+        let mut post = pre;
+        post[leg] = post_foot;
+        let pitch = self.step_pitch(&pre, &post, yaw);
+        let mut ground = pre.map(|f| f[2]);
+        ground[leg] = pre[leg][2].max(post_foot[2]);
+        let rpy = [0.0, pitch, yaw];
+        let lifted_at = |f: [f64; 3]| {
+            let mut feet = pre;
+            feet[leg] = [f[0], f[1], swing_z];
+            feet
+        };
+        // On the ground at both ends, then the swing at most 5 cm apart, ends included.
+        let (a, b) = (pre[leg], post_foot);
+        let n = ((b[0] - a[0]).hypot(b[1] - a[1]) / SWING_SAMPLE_M).ceil().max(1.0) as usize;
+        let mut variants = vec![pre, post];
+        variants.extend((0..=n).map(|k| {
+            let t = k as f64 / n as f64;
+            lifted_at([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, 0.0])
+        }));
+        let probes: Vec<ReachProbe> = variants
+            .iter()
+            .map(|feet| ReachProbe::new(robot, feet, [true; 4], xy, rpy, &ground, self))
+            .collect();
+        self.heights()
+            .filter(|&h| {
+                probes.iter().all(|p| p.distances_ok(h).is_ok())
+                    && variants.iter().all(|feet| {
+                        let p = level_posture(robot, *feet, [true; 4], xy, rpy, h, ground);
+                        solve_legs(robot, &p, self.reach_margin_m).is_ok()
+                    })
+            })
+            .collect()
+    }
+}
+
+/// Spacing of the swing points [`StandingRule::step_heights`] checks, m.
+const SWING_SAMPLE_M: f64 = 0.05;
+
+/// The cheap part of [`solve_legs`] for one set of feet at every height of the rule: the
+/// rotation and the feet in the base frame are computed once; lowering the base by δ
+/// moves every foot by δ·Rᵀe_z in the base frame, so each height costs four distance
+/// checks. The joint-limit part stays with [`solve_legs`].
+struct ReachProbe {
+    /// Feet relative to their hips in the base frame at `h0`.
+    local0: [[f64; 3]; 4],
+    /// Rᵀ·e_z: world up in the base frame.
+    up: [f64; 3],
+    h0: f64,
+    /// Ankle offset below the contact point in the base frame (x', z').
+    ankle: [f64; 2],
+    limit: f64,
+    reach_margin: f64,
+    contact: [bool; 4],
+}
+
+impl ReachProbe {
+    fn new(
+        robot: &RobotDescription,
+        feet: &[[f64; 3]; 4],
+        contact: [bool; 4],
+        xy: [f64; 2],
+        rpy: [f64; 3],
+        ground: &[f64; 4],
+        rule: &StandingRule,
+    ) -> Self {
+        let h0 = rule.leg_height_m;
+        let p = level_posture(robot, *feet, contact, xy, rpy, h0, *ground);
+        let r = rotation(rpy);
+        let below = robot.foot_length + robot.wheel_radius;
+        Self {
+            local0: super::kinematics::contacts_in_base(robot, &p),
+            up: [r[2][0], r[2][1], r[2][2]],
+            h0,
+            ankle: [below * (-rpy[1]).sin(), below * (-rpy[1]).cos()],
+            limit: robot.thigh_length + robot.shin_length - rule.reach_margin_m,
+            reach_margin: rule.reach_margin_m,
+            contact,
+        }
+    }
+
+    /// Whether every leg's hip-to-ankle distance at leg height `h` leaves the reach
+    /// margin, and every foot in contact lies on its leg plane (as [`solve_legs`]).
+    fn distances_ok(&self, h: f64) -> Result<(), PostureError> {
+        let d = self.h0 - h;
+        for leg in crate::robot::Leg::ALL {
+            let i = leg.index();
+            let c = [
+                self.local0[i][0] + d * self.up[0],
+                self.local0[i][1] + d * self.up[1],
+                self.local0[i][2] + d * self.up[2],
+            ];
+            if self.contact[i] && c[1].abs() > super::kinematics::MAX_LATERAL_MISMATCH_M {
+                return Err(PostureError::Lateral { leg, offset: c[1] });
+            }
+            let distance = (c[0] + self.ankle[0]).hypot(c[2] + self.ankle[1]);
+            if distance > self.limit {
+                return Err(PostureError::ReachMargin { leg, distance, margin: self.reach_margin });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Base origin height for the base at `rpy` such that the hip over the highest of `ground`
+/// (per leg, m) stands `height` above it and no hip stands lower above its ground.
+pub fn base_z(robot: &RobotDescription, ground: &[f64; 4], rpy: [f64; 3], height: f64) -> f64 {
+    let r = rotation(rpy);
+    (0..4)
+        .map(|i| {
+            let h = robot.hips[i];
+            ground[i] + height - (r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2])
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// The posture with the base at `xy`, `rpy` and the height of [`base_z`]; feet not in
+/// `contact` are moved onto their legs' planes (same base-frame x' and z').
+pub fn level_posture(
+    robot: &RobotDescription,
+    feet: [[f64; 3]; 4],
+    contact: [bool; 4],
+    xy: [f64; 2],
+    rpy: [f64; 3],
+    height: f64,
+    ground: [f64; 4],
+) -> Posture {
+    let z = base_z(robot, &ground, rpy, height);
+    let mut p = Posture { base_position: [xy[0], xy[1], z], base_rpy: rpy, feet, contact };
+    if contact.iter().any(|c| !c) {
+        let r = rotation(rpy);
+        let local = super::kinematics::contacts_in_base(robot, &p);
+        for i in 0..4 {
+            if !contact[i] {
+                let h = robot.hips[i];
+                p.feet[i] =
+                    apply(&r, p.base_position, [local[i][0] + h[0], h[1], local[i][2] + h[2]]);
+            }
+        }
+    }
+    p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rule() -> StandingRule {
+        StandingRule::from_params(&Params::default())
+    }
+
+    #[test]
+    fn heights_run_from_the_soft_constraint_to_driving_height() {
+        let h: Vec<f64> = rule().heights().collect();
+        assert_eq!(h.len(), 19);
+        assert!((h[0] - 0.45).abs() < 1e-12 && (h[18] - 0.27).abs() < 1e-9);
+    }
+
+    #[test]
+    fn base_height_follows_the_highest_foot_by_hand() {
+        // Level base, feet on 0 except FL on 0.2: the FL hip (0.05 m below the origin)
+        // stands 0.45 above 0.2, so the origin is at 0.2 + 0.45 + 0.05.
+        let robot = RobotDescription::reference();
+        let z = base_z(&robot, &[0.2, 0.0, 0.0, 0.0], [0.0; 3], 0.45);
+        assert!((z - 0.7).abs() < 1e-12);
+        // Pitched nose up by a (negative pitch): the front hips rise by 0.35·sin a, so the
+        // highest ground's hip needs less origin height.
+        let a = 0.1f64;
+        let z = base_z(&robot, &[0.2, 0.2, 0.0, 0.0], [0.0, -a, 0.0], 0.45);
+        let front_hip_dz = -(-a).sin() * 0.35 + (-a).cos() * -0.05;
+        assert!((z - (0.65 - front_hip_dz)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn stand_lowers_until_the_long_leg_reaches() {
+        // Front feet 0.2 m up, rear feet 0.36 m behind their hips: at 0.45 the rear legs
+        // (about 0.57 m) cannot reach 0.36 m back; a lower height can.
+        let robot = RobotDescription::reference();
+        let feet = [[0.35, 0.32, 0.2], [0.35, -0.32, 0.2], [-0.71, 0.32, 0.0], [-0.71, -0.32, 0.0]];
+        let (p, h) = rule().stand(&robot, feet, [0.0, 0.0], 0.0).unwrap();
+        assert!(h < 0.45 - 1e-9, "height {h}");
+        assert!(solve_legs(&robot, &p, 0.002).is_ok());
+        // The leg height one step above fails.
+        let above = level_posture(
+            &robot,
+            feet,
+            [true; 4],
+            [0.0, 0.0],
+            p.base_rpy,
+            h + 0.01,
+            feet.map(|f| f[2]),
+        );
+        assert!(solve_legs(&robot, &above, 0.002).is_err());
+        // Far out of reach: a clear error.
+        let far = [[0.35, 0.32, 0.0], [0.35, -0.32, 0.0], [-1.2, 0.32, 0.0], [-0.35, -0.32, 0.0]];
+        assert!(rule().stand(&robot, far, [0.0, 0.0], 0.0).is_err());
+    }
+
+    #[test]
+    fn a_rear_step_up_counts_the_higher_ground() {
+        let robot = RobotDescription::reference();
+        let r = rule();
+        // Front feet on a 0.2 m platform, rear feet under their hips on the floor; the
+        // rear-left foot steps 0.3 m forward onto the platform.
+        let pre = [[0.35, 0.32, 0.2], [0.35, -0.32, 0.2], [-0.35, 0.32, 0.0], [-0.35, -0.32, 0.0]];
+        let hs = r.step_heights(&robot, pre, 2, [-0.05, 0.32, 0.2], [0.0, 0.0], 0.0, 0.25);
+        assert!(!hs.is_empty());
+        // Every height listed really reaches with the stepping leg over 0.2 m…
+        let mut post = pre;
+        post[2] = [-0.05, 0.32, 0.2];
+        let pitch = r.step_pitch(&pre, &post, 0.0);
+        for &h in &hs {
+            let p = level_posture(
+                &robot,
+                pre,
+                [true; 4],
+                [0.0, 0.0],
+                [0.0, pitch, 0.0],
+                h,
+                [0.2, 0.2, 0.2, 0.0],
+            );
+            assert!(solve_legs(&robot, &p, 0.002).is_ok());
+        }
+        // …and with the other rear foot 0.4 m behind its hip no height does.
+        let mut stretched = pre;
+        stretched[3][0] = -0.75;
+        let hs = r.step_heights(&robot, stretched, 2, [-0.05, 0.32, 0.2], [0.0, 0.0], 0.0, 0.25);
+        assert!(hs.is_empty(), "{hs:?}");
+    }
+
+    #[test]
+    fn the_reach_probe_agrees_with_the_leg_solver() {
+        // Over a grid of rear-foot offsets, platform heights and leg heights, the cheap
+        // distance check fails exactly when solve_legs reports a reach or lateral error.
+        let robot = RobotDescription::reference();
+        let r = rule();
+        let (mut checked, mut unreachable) = (0, 0);
+        for rear_dx in [-0.45, -0.3, -0.1, 0.0, 0.2] {
+            for up in [0.0, 0.1, 0.2, 0.3] {
+                let feet = [
+                    [0.4, 0.32, up],
+                    [0.35, -0.32, up],
+                    [-0.35 + rear_dx, 0.32, 0.0],
+                    [-0.35, -0.32, 0.0],
+                ];
+                let ground = feet.map(|f| f[2]);
+                let rpy = [0.0, r.pitch(&feet, 0.3), 0.3];
+                let (s3, c3) = 0.3f64.sin_cos();
+                let world = feet.map(|f| [c3 * f[0] - s3 * f[1], s3 * f[0] + c3 * f[1], f[2]]);
+                let probe =
+                    ReachProbe::new(&robot, &world, [true; 4], [0.0, 0.0], rpy, &ground, &r);
+                for h in r.heights() {
+                    let p = level_posture(&robot, world, [true; 4], [0.0, 0.0], rpy, h, ground);
+                    let full = solve_legs(&robot, &p, r.reach_margin_m);
+                    let geometric = matches!(
+                        full,
+                        Err(PostureError::ReachMargin { .. } | PostureError::Lateral { .. })
+                    );
+                    assert_eq!(probe.distances_ok(h).is_err(), geometric, "{rear_dx} {up} {h}");
+                    checked += 1;
+                    unreachable += usize::from(geometric);
+                }
+            }
+        }
+        assert_eq!(checked, 5 * 4 * 19);
+        assert!(unreachable > 20 && unreachable < checked - 20, "{unreachable} of {checked}");
+    }
+}
