@@ -572,12 +572,6 @@ impl StepExecutor {
 
     /// Starts work toward keyframe `i`.
     fn advance(&mut self, i: usize, time: f64) {
-        if std::env::var_os("MOMARO_TRACE").is_some() {
-            eprintln!(
-                "TRACE t={time:.2} -> key {i} {:?}",
-                self.keys.get(i).map(|k| (k.phase, k.leg, k.time_s, k.base_position))
-            );
-        }
         let Some(k) = self.keys.get(i) else {
             self.mode = Mode::Finished;
             return;
