@@ -3,8 +3,9 @@
 //! each lift and contact confirmed before weight goes back onto a placed foot.
 //!
 //! Whole missions are tested too but ignored while they fail (see their reasons); the
-//! prefixes that pass are executed here: the staircase's front steps onto two treads, the
-//! platform's first front step up.
+//! prefixes that pass are executed here: the staircase's front steps onto the first and
+//! second treads, the platform's first front step up, a push during a swing, and an
+//! aborted step with its replan.
 
 mod common;
 
@@ -64,7 +65,17 @@ fn prefix_keyframes(
             d.steps = d.keyframes.iter().filter(|k| k.phase == Phase::Place).count();
             d
         }
-        Err(_) => run::expand_mission(sc, sim, plan, end).expect("prefix expands"),
+        Err(_) => {
+            let mut d = run::expand_mission(sc, sim, plan, end).expect("prefix expands");
+            // The prefix closes by lowering to the driving posture, whose feet are the
+            // neutral footprint under the base: after the front steps up that would drag the
+            // front wheels back off the tread (the generator's closing lowering assumes a
+            // neutral footprint). The cut prefix ends standing instead.
+            if d.keyframes.last().is_some_and(|k| k.phase == Phase::Lower) {
+                d.keyframes.pop();
+            }
+            d
+        }
     }
 }
 
@@ -75,8 +86,15 @@ fn execute_prefix(sc: &Scenario, end: End, push: Option<Push>) -> RunSummary {
     let mut sim = Simulation::new(sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
     let plan = plan::run(sc, &robot, &plan_options()).expect("plan");
-    let end = prefix_end(&plan, end);
+    let mut end = prefix_end(&plan, end);
     assert!(end < plan.path.len(), "the prefix ends before the goal");
+    // Without the planned base shift that prepares a rear step up: it moves the base
+    // forward and down with the front feet on higher ground, and the generator, which
+    // checks reach, joint limits and stability but not leg–terrain collisions, folds the
+    // front legs onto the tread (MuJoCo: thigh and shin touch it).
+    if plan.path[end - 1].kind == PathKind::BaseShift {
+        end -= 1;
+    }
     let detailed = prefix_keyframes(sc, &mut sim, &plan, end);
     momaro::jobs::stand_at_start(&mut sim, sc).expect("stands");
     let opts =
@@ -138,15 +156,8 @@ fn platform_prefix_first_front_foot_climbs_onto_the_platform() {
 }
 
 #[test]
-#[ignore = "fails since the merge of main's generator changes (03f0529): both front steps \
-            onto the first tread are executed (margins 0.128 and 0.125 m), but at t = 36.0 s, \
-            in the closing segments of the second step, a support wheel loses contact and the \
-            measured margin falls to -0.36 m (monitor tip-over); not yet diagnosed. Before \
-            the merge the staircase's front steps and first rear step up passed (5 of 5, \
-            min margin 0.027 m)"]
 fn staircase_prefix_front_feet_climb_the_first_tread() {
-    // Up to and including the second front step up; after the front steps onto the second
-    // tread the plan folds the front legs onto the tread (see the ignored test below).
+    // Up to and including the second front step up.
     let sc = common::scenario("staircase");
     let s = execute_prefix(&sc, End::AfterFrontStepUp(1), None);
     assert_clean(&s);
@@ -155,10 +166,20 @@ fn staircase_prefix_front_feet_climb_the_first_tread() {
 }
 
 #[test]
-#[ignore = "fails since the merge of main's generator changes (03f0529): after the front \
-            steps onto the second tread, the front legs' thighs and shins touch the tread \
-            (t = 78 s), the base is held back and the executor reports a 0.15 m drift; the \
-            rear-left step up is aborted (margin -0.017 m before the lift)"]
+fn staircase_prefix_front_feet_climb_two_treads() {
+    // Up to the first rear step up: the front feet onto the first and second treads.
+    let sc = common::scenario("staircase");
+    let s = execute_prefix(&sc, End::BeforeRearStepUp(0), None);
+    assert_clean(&s);
+    let legs = stepped(&s);
+    assert!(legs.len() >= 4 && legs.iter().all(|l| l.is_front()), "{legs:?}");
+}
+
+#[test]
+#[ignore = "fails: the planned base shift that prepares the rear step up (path element 33: \
+            base 0.3 m forward, 7 cm down) folds the front legs onto the second tread \
+            (thighs and shins touch it at t = 78 s, the base is held back), and the rear-left \
+            step up is then aborted (support margin -0.017 m before the lift)"]
 fn staircase_prefix_with_the_first_rear_step_up() {
     let sc = common::scenario("staircase");
     let s = execute_prefix(&sc, End::BeforeRearStepUp(1), None);
