@@ -595,7 +595,7 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 let c = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.3}"));
                 say!("scenario {} (setup {:.1} ms)", report.scenario, report.setup_time_s * 1e3);
                 say!(
-                    "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12}",
+                    "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12} {:>10} {:>10}",
                     "algo",
                     "nbhd",
                     "optimum",
@@ -603,11 +603,13 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                     "over opt",
                     "cost@1s",
                     "cost@10s",
-                    "to optimum"
+                    "to optimum",
+                    "first exp",
+                    "h setup"
                 );
                 for r in &report.rows {
                     say!(
-                        "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12}",
+                        "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12} {:>10} {:>10}",
                         r.algorithm,
                         r.neighbourhood,
                         c(r.optimum),
@@ -615,7 +617,9 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                         pct(r.first_over_optimum_pct),
                         c(r.cost_at_1s),
                         c(r.cost_at_10s),
-                        ms(r.time_to_optimum_s)
+                        ms(r.time_to_optimum_s),
+                        r.first_expansions.map_or("-".to_owned(), |e| e.to_string()),
+                        ms(Some(r.heuristic_setup_s))
                     );
                 }
             }

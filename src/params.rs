@@ -99,12 +99,11 @@ pub struct Params {
     /// Smallest longitudinal gap the displaced wheel pair keeps to the stepping foot, m.
     /// Ours: 0.3 m (two wheel pairs' length with room to spare).
     pub wheel_gap_m: f64,
-    /// Planner's support check for a step: the signed distance of the base centre to the
+    /// Planner's support check for a step: the signed distance of a CoM estimate to the
     /// support triangle of the other three feet (the partner wheel moved toward the
     /// centre as the generator would) must be at least this, m. Base roll (eqs. 6–8) and a
-    /// base shift take the CoM the rest of the way. Ours: 0.05 m, about how far the CoM
-    /// projects behind the base centre with the base pitched on the stairs (the paper
-    /// leaves stability to the generator, whose failures it does not report).
+    /// base shift take the CoM the rest of the way. Ours: 0.02 m (the paper leaves
+    /// stability to the generator, whose failures it does not report).
     pub step_support_margin_m: f64,
 
     /// ARA*: initial heuristic weight (Sec. VIII): 3.0.
@@ -146,7 +145,7 @@ impl Default for Params {
             min_lift_margin_m: 0.02,
             max_wheel_to_centre_m: 0.45,
             wheel_gap_m: 0.3,
-            step_support_margin_m: 0.05,
+            step_support_margin_m: 0.02,
             arastar_initial_epsilon: 3.0,
             arastar_epsilon_decay: 0.5,
         }

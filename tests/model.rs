@@ -155,6 +155,10 @@ fn reference_description_for_unit_tests_equals_the_model() {
         (got.wheel_track, reference.wheel_track),
         (got.base_bottom_z, reference.base_bottom_z),
         (got.total_mass, reference.total_mass),
+        (got.body_mass, reference.body_mass),
+        (got.body_com[0], reference.body_com[0]),
+        (got.body_com[1], reference.body_com[1]),
+        (got.body_com[2], reference.body_com[2]),
     ] {
         assert!(close(a, b), "{a} vs {b}: update RobotDescription::reference()");
     }

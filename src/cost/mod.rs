@@ -405,6 +405,8 @@ mod tests {
             base_half_extents: [0.45, 0.25, 0.1],
             base_bottom_z: -0.05,
             total_mass: 50.0,
+            body_mass: 30.0,
+            body_com: [0.0, 0.0, 0.2],
         }
     }
 

@@ -644,8 +644,15 @@ pub struct BenchRow {
     pub cost_at_10s: Option<f64>,
     /// Time until a solution of optimal cost was found, s.
     pub time_to_optimum_s: Option<f64>,
+    /// Expansions up to the first solution.
+    pub first_expansions: Option<u64>,
+    /// Expansions of the whole run.
+    pub expansions: u64,
     /// Expansions per second of the run.
     pub expansions_per_s: f64,
+    /// Time to build the graph's heuristic (the step bound), s: spent before the search
+    /// starts, so not in any of the search times above.
+    pub heuristic_setup_s: f64,
     /// `(time_s, cost)` of every solution.
     pub solutions: Vec<(f64, f64)>,
 }
@@ -677,25 +684,28 @@ pub fn bench(
     let file = || scenario.path.clone();
     let prep = prepare(scenario, robot, opts.k12, None)?;
     let k12 = prep.params.k12;
-    let run_one = |algorithm, n, limit| -> Result<SearchResult<LatticeState>, PlanJobError> {
-        let mut g = prep
-            .graph(robot, n, k12)
-            .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
-        let p = SearchParams {
-            initial_epsilon: prep.params.arastar_initial_epsilon,
-            epsilon_decay: prep.params.arastar_epsilon_decay,
-            time_limit: Some(limit),
-            ..SearchParams::default()
+    let run_one =
+        |algorithm, n, limit| -> Result<(SearchResult<LatticeState>, f64), PlanJobError> {
+            let mut g = prep
+                .graph(robot, n, k12)
+                .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
+            let setup = g.heuristic_setup_time().as_secs_f64();
+            let p = SearchParams {
+                initial_epsilon: prep.params.arastar_initial_epsilon,
+                epsilon_decay: prep.params.arastar_epsilon_decay,
+                time_limit: Some(limit),
+                ..SearchParams::default()
+            };
+            search(&mut g, prep.start, algorithm, &p, None)
+                .map(|r| (r, setup))
+                .map_err(|source| PlanJobError::Search { scenario: file(), source })
         };
-        search(&mut g, prep.start, algorithm, &p, None)
-            .map_err(|source| PlanJobError::Search { scenario: file(), source })
-    };
     let mut rows = Vec::new();
-    let astar16 = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit)?;
-    rows.push(row("astar", "n16", &astar16, optimum_of(&astar16), &astar16));
-    let astar20 = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit)?;
-    let ara = run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit)?;
-    rows.push(row("arastar", "n20", &ara, optimum_of(&astar20), &astar20));
+    let (astar16, setup16) = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit)?;
+    rows.push(row("astar", "n16", &astar16, optimum_of(&astar16), &astar16, setup16));
+    let (astar20, _) = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit)?;
+    let (ara, setup20) = run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit)?;
+    rows.push(row("arastar", "n20", &ara, optimum_of(&astar20), &astar20, setup20));
     Ok(BenchReport { scenario: scenario.name.clone(), setup_time_s: prep.setup_time_s, rows })
 }
 
@@ -711,6 +721,7 @@ fn row(
     r: &SearchResult<LatticeState>,
     optimum: Option<f64>,
     reference: &SearchResult<LatticeState>,
+    heuristic_setup_s: f64,
 ) -> BenchRow {
     let sols: Vec<(f64, f64)> =
         r.solutions.iter().map(|s| (s.time.as_secs_f64(), s.cost.to_f64())).collect();
@@ -731,7 +742,10 @@ fn row(
         cost_at_1s: at(1.0),
         cost_at_10s: at(10.0),
         time_to_optimum_s: time_to_optimum,
+        first_expansions: r.solutions.first().map(|s| s.expansions),
+        expansions: r.expansions,
         expansions_per_s: r.expansions as f64 / r.elapsed.as_secs_f64().max(1e-9),
+        heuristic_setup_s,
         solutions: sols,
     }
 }

@@ -266,7 +266,9 @@ impl<C: PoseCostSource> SearchGraph for DrivingGraph<'_, C> {
     fn heuristic(&self, s: LatticeState) -> Cost {
         let di = f64::from(i32::from(self.goal.i) - i32::from(s.i));
         let dj = f64::from(i32::from(self.goal.j) - i32::from(s.j));
-        let mut h = di.hypot(dj) * self.lattice.resolution;
+        // Cell offsets are small integers: `sqrt` is exact enough (the heuristic slack
+        // covers its rounding) and much cheaper than libm's `hypot`.
+        let mut h = (di * di + dj * dj).sqrt() * self.lattice.resolution;
         if let Some(g) = self.goal.theta {
             let steps = self.lattice.orientation_steps_between(s.theta, g);
             h += f64::from(steps) * self.turn_length;

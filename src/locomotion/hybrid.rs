@@ -38,10 +38,10 @@
 //!   the scans.
 //! - *Support for a step.* The paper leaves static stability to the step motion
 //!   generator. A plan whose step no alignment can stabilise is useless to it, so a step
-//!   also needs the base centre (about where the CoM projects) inside the support
-//!   triangle of the other three feet, with the partner wheel driven toward the centre as
-//!   far as the generator may (`Params::step_support_margin_m`, 5 cm): roll and a base
-//!   shift align the rest.
+//!   also needs a CoM estimate (`motion::standing::com_estimate`: base body and legs
+//!   lumped, the robot standing by the rule) inside the support triangle of the other
+//!   three feet, with the partner wheel driven toward the centre as far as the generator
+//!   may (`Params::step_support_margin_m`): roll and a base shift align the rest.
 //! - *Which footholds count as a step.* A step must carry the foot *over* untraversable
 //!   terrain: its straight sagittal line crosses at least one cell of infinite foot cost.
 //!   A foothold reachable over finite cells only is a wheel drive (front foot forward /
@@ -61,24 +61,43 @@
 //!   same issue). The edge cost is `max(C_BS · factor, distance moved)`, which keeps the
 //!   heuristic consistent even for factors below 2.
 //!
-//! **Heuristic**: that of [`DrivingGraph`] — Euclidean distance plus the orientation
-//! difference times the turning radius. Steps and foot moves leave the base in place and
-//! cost ≥ 0; drives and base shifts cost at least the distance they move the base; so it
-//! stays consistent (and admissible).
+//! **Heuristic** (issue 4), a sum of three parts, each consistent on every manoeuvre:
+//!
+//! 1. that of [`DrivingGraph`]: Euclidean distance plus the orientation difference times
+//!    the turning radius. Steps and foot moves leave the base in place; drives and base
+//!    shifts cost at least the distance they move the base (pose costs ≥ 1, k_Δθ ≥ 1,
+//!    and a base shift's cost is at least its move); turns cost at least their arc;
+//! 2. the step bound Σ_k S_k of the `heuristic` module: per foot, the cheapest chain of
+//!    steps (C_S, eq. 5, times the step-related factor) from the foot's component of
+//!    finite-C_F cells to the component of its goal position. Only a step moves a foot
+//!    between components, and it costs at least the bound's drop;
+//! 3. the foot-offset potential c · Σ_k |o_k| (offsets in metres; zero for the neutral
+//!    footprint): every offset must be undone before the neutral goal, and each
+//!    manoeuvre that changes offsets pays c per metre — foot moves by eq. 6 (C_F ≥ the
+//!    map's smallest), base shifts by C_BS ≥ f · k10 · L (C_B ≥ 1, eq. 3) with room
+//!    left for part 1, steps by the share λ of eq. 5's k7 term that part 2 leaves out
+//!    (`heuristic::offset_potential`).
+//!
+//! Part 2 is zero where no step is needed and part 3 for the neutral footprint, so a
+//! driving state on flat ground gets part 1 alone, as before. The
+//! proofs are in the `heuristic` module docs; `locomotion::tests` checks
+//! `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge.
 
 use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, edge_cost};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
+use super::heuristic::{StepBound, StepBoundParams};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::geometry::Pose2;
 use crate::motion::kinematics::hips_in_world;
-use crate::motion::standing::StandingRule;
+use crate::motion::standing::{StandingRule, com_estimate};
 use crate::params::Params;
 use crate::planner::{Cost, SearchGraph};
 use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
 use crate::stability::stability_margin;
 use serde::Serialize;
+use std::time::{Duration, Instant};
 
 /// What an edge of the hybrid graph does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -262,6 +281,10 @@ pub struct HybridGraph<'c> {
     /// Scratch buffer for the labelled special successors.
     special: Vec<(LatticeState, Cost, Manoeuvre)>,
     stats: ManoeuvreStats,
+    /// The step-cost part of the heuristic (`heuristic`), built once per graph.
+    step_bound: StepBound,
+    /// Time spent building `step_bound`.
+    heuristic_setup: Duration,
 }
 
 /// The offsets (cells, −64..=63) at which `leg` reaches its foot with the hip `height`
@@ -319,10 +342,14 @@ impl<'c> HybridGraph<'c> {
         let reach = union.map(bit_range);
         let trig = (0..lattice.orientations).map(|k| lattice.yaw(k as u8).sin_cos()).collect();
         let foot_move_cells = (config.foot_move_increment_m / res).round().clamp(1.0, 127.0) as i8;
+        let near = near_obstacle_layer(maps, config.step_obstacle_distance_m);
+        let t0 = Instant::now();
+        let step_bound = build_step_bound(maps, &near, &config, &lattice, goal);
+        let heuristic_setup = t0.elapsed();
         Ok(Self {
             maps,
             driving: DrivingGraph::new(maps, lattice, config.driving, goal),
-            near: near_obstacle_layer(maps, config.step_obstacle_distance_m),
+            near,
             config,
             lattice,
             neutral: maps.neutral_footprint(),
@@ -333,7 +360,20 @@ impl<'c> HybridGraph<'c> {
             foot_move_cells,
             special: Vec::with_capacity(16),
             stats: ManoeuvreStats::default(),
+            step_bound,
+            heuristic_setup,
         })
+    }
+
+    /// Time spent building the heuristic's step bound when the graph was made (not part
+    /// of any search's time).
+    pub fn heuristic_setup_time(&self) -> Duration {
+        self.heuristic_setup
+    }
+
+    /// Number of foot components the step bound found (0: no step bound).
+    pub fn step_bound_components(&self) -> usize {
+        self.step_bound.components()
     }
 
     /// The lattice.
@@ -772,14 +812,13 @@ impl<'c> HybridGraph<'c> {
         }
     }
 
-    /// Whether the base centre of state `s` lies in the support triangle of a step of
+    /// Whether the CoM estimate of state `s` standing by the rule
+    /// ([`com_estimate`]) lies in the support triangle of a step of
     /// `leg` to `post` (x, y) with at least `step_support_margin_m`: the triangle of the
     /// other three feet, the partner on the stepping side driven toward the centre as far
     /// as the generator may (`max_wheel_to_centre_m`, keeping `wheel_gap_m` to the
     /// stepping foot at both ends, stopping before untraversable cells and height
-    /// changes), as in Sec. VI-A. The CoM projects near the base centre (up to about 5 cm
-    /// behind it with the base pitched on stairs, which the margin covers); roll and a base
-    /// shift align the rest.
+    /// changes), as in Sec. VI-A. Roll and a base shift align the rest.
     fn step_supported(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
         let p = self.lattice.pose(s);
         let (hx, hy) = self.heading(s.theta);
@@ -813,7 +852,12 @@ impl<'c> HybridGraph<'c> {
             .filter(|&k| k != leg)
             .map(|k| if k == partner { moved } else { feet.pos[k] })
             .collect();
-        stability_margin(&support, [p.x, p.y]) >= c.step_support_margin_m
+        let Ok((stance, _)) =
+            c.standing.stand(&self.robot, Self::feet_xyz(feet), [p.x, p.y], p.theta)
+        else {
+            return false;
+        };
+        stability_margin(&support, com_estimate(&self.robot, &stance)) >= c.step_support_margin_m
     }
 
     /// Whether the robot can stand by the rule with its base `l` cells ahead of state
@@ -920,6 +964,42 @@ impl<'c> HybridGraph<'c> {
     }
 }
 
+/// The step bound of the heuristic for `goal` (every orientation when the goal leaves it
+/// free). The link radius covers the largest jump of a foot's cell in a drive (2), a
+/// turn (the chord of the widest foot) and a base shift (1), plus one against rounding.
+fn build_step_bound(
+    maps: &CostMaps,
+    near: &[bool],
+    config: &HybridConfig,
+    lattice: &Lattice,
+    goal: DrivingGoal,
+) -> StepBound {
+    let res = lattice.resolution;
+    let radius = maps.neutral_footprint().iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
+    let chord = 2.0 * radius * (0.5 * lattice.orientation_step()).sin();
+    let chord_cells = if lattice.orientations > 1 { (chord / res).ceil() } else { 0.0 };
+    let link_cells = chord_cells.clamp(2.0, 1000.0) as usize + 1;
+    let params = StepBoundParams {
+        step_cost_factor: config.step_cost_factor,
+        k7: config.k7,
+        k8: config.k8,
+        k9: config.k9,
+        max_step_height_m: config.max_step_height_m,
+        link_cells,
+        k10: config.k10,
+        k11: config.k11,
+    };
+    let thetas: Vec<u8> = match goal.theta {
+        Some(t) => vec![t],
+        None => (0..lattice.orientations).map(|k| k as u8).collect(),
+    };
+    let goal_feet: Vec<[[f64; 2]; 4]> = thetas
+        .into_iter()
+        .map(|theta| maps.neutral_feet(&lattice.pose(LatticeState::new(goal.i, goal.j, theta))))
+        .collect();
+    StepBound::build(maps, near, &params, &goal_feet)
+}
+
 /// The criterion-1 pre-filter: per cell, whether an infinite-foot-cost cell's centre lies
 /// within `radius` plus half a cell diagonal of the cell's centre (so for every point of
 /// the cell, "an infinite cell closer than `radius`" implies the flag). Stamps a disc
@@ -979,8 +1059,17 @@ impl SearchGraph for HybridGraph<'_> {
         out.extend(self.special.iter().map(|&(t, c, _)| (t, c)));
     }
 
+    /// The driving heuristic (Euclidean distance plus turn, [`DrivingGraph`]) plus the
+    /// step bound Σ_k S_k of the four feet (`heuristic` module): consistent on every
+    /// manoeuvre (see the module docs of both).
     fn heuristic(&self, s: LatticeState) -> Cost {
-        self.driving.heuristic(s)
+        let h = self.driving.heuristic(s);
+        let Some(o) = self.footprints.get(s.footprint) else {
+            return h;
+        };
+        let feet = self.feet_pos(s, &o);
+        h.saturating_add(self.step_bound.lower_bound(self.maps, &feet))
+            .saturating_add(self.step_bound.offset_potential(&o))
     }
 
     fn is_goal(&self, s: LatticeState) -> bool {

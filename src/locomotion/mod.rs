@@ -8,11 +8,15 @@
 //! - [`driving`]: the driving graph (moves and turns on the spot, their costs, the
 //!   heuristic) and `plan_driving`.
 //! - [`footprint`]: footprints (per-leg longitudinal foot offsets) interned as small ids.
+//! - [`heuristic`]: the informed part of the hybrid heuristic — a lower bound on the step
+//!   costs (eq. 5) each foot still needs, and the foot-offset potential; built once per
+//!   graph.
 //! - [`hybrid`]: the full hybrid graph — driving plus abstract steps, base shifts and
 //!   single-foot moves (Sec. V), with their costs C_S (eq. 5), C_BS and C_FM (eq. 6).
 
 pub mod driving;
 pub mod footprint;
+pub mod heuristic;
 pub mod hybrid;
 pub mod lattice;
 pub mod orientation;

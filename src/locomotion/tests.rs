@@ -453,23 +453,94 @@ mod hybrid {
         assert!(g.driving_pose_cost(s).is_some());
     }
 
+    /// The plain driving heuristic (Euclidean distance plus turn) of `s` in `g`.
+    fn driving_heuristic(g: &HybridGraph<'_>, s: LatticeState) -> Cost {
+        let l = *g.lattice();
+        let cfg = g.config().driving;
+        let goal = DrivingGoal::at(LatticeState::new(120, 40, 0));
+        DrivingGraph::new(&|_: &Pose2| Some(1.0), l, cfg, goal).heuristic(s)
+    }
+
+    #[test]
+    fn step_bound_is_one_platform_step_per_foot() {
+        // Floor and platform top are two foot components 0.2 m apart in height. C_F is
+        // infinite within r_F = 0.12 m of the edge cells (centres 0.9875 and 1.0125), so
+        // the last finite floor cell is centred at 0.8625 and the first platform one at
+        // 1.1375: 11 cells apart, a step at least 11 / 1.0824 − √2 cells long (octile
+        // over Euclidean distance, feet within half a cell diagonal of their centres).
+        // The offset potential takes c = (f · k10 − 1 − 1/√2) / 4 per metre of offset,
+        // paid by the share λ = c / (f · k7) of eq. 5's k7 term. Per foot
+        // f · ((1 − λ) · k7 · L + k9 · 0.2), with C_F = 1 on the flat platform.
+        let maps = platform_maps(0.2);
+        let goal = LatticeState::new(120, 40, 0);
+        let g = graph(&maps, goal);
+        assert!(g.step_bound_components() >= 2, "{}", g.step_bound_components());
+        let p = Params::default();
+        let f = p.step_cost_factor;
+        let octile = (1.0 + (std::f64::consts::SQRT_2 - 1.0).powi(2)).sqrt();
+        let l = (11.0 / octile - std::f64::consts::SQRT_2) * 0.025 * (1.0 - 1e-9);
+        let c = (f * p.k10 - 1.0 - std::f64::consts::FRAC_1_SQRT_2) / 4.0;
+        let lambda = c / (f * p.k7);
+        let per_foot =
+            Cost::from_f64_floor(f * ((1.0 - lambda) * p.k7 * l + p.k9 * 0.2) * (1.0 - 1e-9));
+        assert!((per_foot.to_f64() - 5.7845).abs() < 1e-3, "{per_foot}");
+        let s = state_at(&g, 0.0, 0.0);
+        assert_eq!(g.heuristic(s), driving_heuristic(&g, s).saturating_add(Cost(4 * per_foot.0)));
+        // Offsets (cells) add c · Σ|o|: 6 cells here (all feet stay on the floor).
+        let mut g = g;
+        let t = g.with_offsets(s, [4, 0, -2, 0]).expect("interned");
+        let phi = Cost::from_f64_floor(c * 6.0 * 0.025 * (1.0 - 1e-9));
+        assert_eq!(g.heuristic(t), g.heuristic(s).saturating_add(phi));
+        // On the platform, with the goal there: no step left, plain driving heuristic.
+        let on = state_at(&g, 2.2, 0.0);
+        assert_eq!(g.heuristic(on), driving_heuristic(&g, on));
+        assert_eq!(g.heuristic(goal), Cost::ZERO);
+        // Flat ground: no obstacle, no step, no bound.
+        let flat = platform_maps(0.0);
+        let g = graph(&flat, goal);
+        assert_eq!(g.heuristic(s), driving_heuristic(&g, s));
+    }
+
+    /// Checks `h(s) ≤ c(s, t) + h(t)` on every labelled successor of `s`; returns the
+    /// successors.
+    fn check_consistent(
+        g: &mut HybridGraph<'_>,
+        s: LatticeState,
+    ) -> Vec<(LatticeState, Cost, Manoeuvre)> {
+        let succ = g.labelled_successors(s);
+        for &(t, c, m) in &succ {
+            let (hs, ht) = (g.heuristic(s), g.heuristic(t));
+            assert!(hs <= c.saturating_add(ht), "h = {hs} > {c} + {ht}: {m:?} from {s:?} to {t:?}");
+        }
+        succ
+    }
+
     #[test]
     fn heuristic_is_consistent_on_every_manoeuvre() {
         let maps = platform_maps(0.2);
         let goal = LatticeState::new(120, 40, 0);
         let mut g = graph(&maps, goal);
-        let mut frontier = vec![state_at(&g, 0.48, 0.0), state_at(&g, 0.3, 0.1)];
+        // Front feet before the edge; rear feet before it with the front ones on the
+        // platform (front foot forward, rear steps).
+        let mut frontier = vec![
+            state_at(&g, 0.48, 0.0),
+            state_at(&g, 0.3, 0.1),
+            state_at(&g, 1.2, 0.0),
+            state_at(&g, 1.16, -0.05),
+        ];
         let mut checked = 0;
-        for _ in 0..6 {
+        let mut kinds = std::collections::BTreeSet::new();
+        let mut stepped = 0;
+        for _ in 0..8 {
             let mut next = Vec::new();
             for s in frontier {
-                for (t, c, m) in g.labelled_successors(s) {
-                    assert!(
-                        g.heuristic(s) <= c.saturating_add(g.heuristic(t)),
-                        "{m:?} from {s:?} to {t:?}"
-                    );
+                for (t, _, m) in check_consistent(&mut g, s) {
                     checked += 1;
-                    if m.kind.is_step_related() {
+                    kinds.insert(m.kind);
+                    if m.kind == ManoeuvreKind::Step && g.heuristic(t) < g.heuristic(s) {
+                        stepped += 1;
+                    }
+                    if m.kind.is_step_related() && next.len() < 400 {
                         next.push(t);
                     }
                 }
@@ -477,6 +548,31 @@ mod hybrid {
             frontier = next;
         }
         assert!(checked > 30, "{checked}");
+        assert_eq!(kinds.len(), 6, "every manoeuvre kind was checked: {kinds:?}");
+        // Steps onto the platform lower the step bound: the tight case was checked.
+        assert!(stepped > 0);
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+
+        /// States near the platform edge (base 0.2–1.3 m, the edge at 1 m) with random
+        /// orientations and footprints: every edge out of them keeps h consistent.
+        #[test]
+        fn heuristic_is_consistent_near_the_platform_edge(
+            x in 0.2f64..1.3, y in -0.3f64..0.3, theta in 0u8..64,
+            o in proptest::array::uniform4(-16i8..=19),
+            neutral in proptest::prelude::any::<bool>(),
+        ) {
+            let maps = platform_maps(0.2);
+            let mut g = graph(&maps, LatticeState::new(120, 40, 0));
+            let s = g.lattice().state(&Pose2::new(x, y, 0.0)).expect("on the map");
+            let s = LatticeState { theta, ..s };
+            let s = if neutral { s } else { g.with_offsets(s, o).expect("interned") };
+            for (t, _, _) in check_consistent(&mut g, s) {
+                check_consistent(&mut g, t);
+            }
+        }
     }
 
     #[test]
@@ -491,9 +587,13 @@ mod hybrid {
         let goal = state_at(&g, 1.5, 0.0);
         let cfg = config();
         let mut g = HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("g");
+        let h0 = g.heuristic(start);
         let a = astar(&mut g, start, &SearchParams::default());
         assert_eq!(a.termination, Termination::OptimalProven);
         let best = a.best().expect("a path up");
+        // Admissible, and informed: the four steps' bound is most of the heuristic.
+        assert!(h0 <= best.cost, "h = {h0} > {}", best.cost);
+        assert!(h0.to_f64() > 1.5 + 4.0 * 4.0, "h = {h0}");
         let kinds: Vec<_> =
             best.path.windows(2).filter_map(|w| g.edge(w[0], w[1]).map(|(_, m)| m.kind)).collect();
         assert_eq!(kinds.len(), best.path.len() - 1, "every edge is labelled");

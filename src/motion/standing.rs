@@ -235,6 +235,27 @@ impl ReachProbe {
     }
 }
 
+/// Horizontal CoM estimate of posture `p` for the planner, which has no MuJoCo: the base
+/// body (everything but the legs) at its own CoM, each leg's share of the rest of the mass
+/// at the middle of its hip and its foot. It catches what the base centre misses: the
+/// upper body leaning back with a pitched base, and legs stretched behind.
+pub fn com_estimate(robot: &RobotDescription, p: &Posture) -> [f64; 2] {
+    let r = rotation(p.base_rpy);
+    let body = apply(&r, p.base_position, robot.body_com);
+    let hips = super::kinematics::hips_in_world(robot, p);
+    let leg_mass = ((robot.total_mass - robot.body_mass) / 4.0).max(0.0);
+    let total = robot.body_mass + 4.0 * leg_mass;
+    if total <= 0.0 {
+        return [p.base_position[0], p.base_position[1]];
+    }
+    let mut c = [robot.body_mass * body[0], robot.body_mass * body[1]];
+    for (h, f) in hips.iter().zip(&p.feet) {
+        c[0] += leg_mass * (h[0] + f[0]) / 2.0;
+        c[1] += leg_mass * (h[1] + f[1]) / 2.0;
+    }
+    [c[0] / total, c[1] / total]
+}
+
 /// Base origin height for the base at `rpy` such that the hip over the highest of `ground`
 /// (per leg, m) stands `height` above it and no hip stands lower above its ground.
 pub fn base_z(robot: &RobotDescription, ground: &[f64; 4], rpy: [f64; 3], height: f64) -> f64 {
@@ -397,5 +418,28 @@ mod tests {
         }
         assert_eq!(checked, 5 * 4 * 19);
         assert!(unreachable > 20 && unreachable < checked - 20, "{unreachable} of {checked}");
+    }
+
+    #[test]
+    fn com_estimate_by_hand() {
+        // Level base at the origin, feet under the hips: 34 kg at (0.04/34, 0), four 6 kg
+        // legs symmetric about the origin, so the CoM is at x = 0.04 / 58.
+        let robot = RobotDescription::reference();
+        let feet = robot.hips.map(|h| [h[0], h[1], -0.4]);
+        let p = Posture { base_position: [0.0; 3], base_rpy: [0.0; 3], feet, contact: [true; 4] };
+        let c = com_estimate(&robot, &p);
+        assert!((c[0] - 0.04 / 58.0).abs() < 1e-12 && c[1].abs() < 1e-12);
+        // Nose up by 0.1 rad: the body CoM (z' = 6.36/34) leans back by z'·sin 0.1; each
+        // hip (z' = −0.05) moves forward by 0.05·sin 0.1, and the front and rear hips'
+        // ±0.35·cos 0.1 cancel, so the four leg midpoints add 4 · 0.05·sin 0.1 / 2.
+        let p = Posture { base_rpy: [0.0, -0.1, 0.0], ..p };
+        let c = com_estimate(&robot, &p);
+        let body_x = 0.04 / 34.0 * 0.1f64.cos() - 6.36 / 34.0 * 0.1f64.sin();
+        let legs_x = 6.0 * 2.0 * 0.05 * 0.1f64.sin();
+        assert!((c[0] - (34.0 * body_x + legs_x) / 58.0).abs() < 1e-12, "{c:?}");
+        // A rear foot stretched 0.4 m back moves 6 kg's midpoint by 0.2 m.
+        let mut q = p;
+        q.feet[2][0] -= 0.4;
+        assert!((com_estimate(&robot, &q)[0] - (c[0] - 6.0 * 0.2 / 58.0)).abs() < 1e-12);
     }
 }

@@ -1,4 +1,4 @@
-//! The OPEN list: a binary min-heap of `(key, h, node)` with lazy deletion.
+//! The OPEN list: a 4-ary min-heap of `(key, h, node)` with lazy deletion.
 //!
 //! When a state's `g` improves it is pushed again; the old entry stays in the heap and is
 //! recognised as stale when popped (its key no longer matches the state's current key,
@@ -11,8 +11,6 @@
 //! are assigned in discovery order, so ties are broken deterministically.
 
 use super::nodes::NodeId;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 
 /// One heap entry (24 bytes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -25,27 +23,25 @@ pub(crate) struct Entry {
     pub node: NodeId,
 }
 
-impl Ord for Entry {
-    /// Reversed, so that `BinaryHeap` (a max-heap) pops the smallest key.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .key
-            .cmp(&self.key)
-            .then_with(|| other.h.cmp(&self.h))
-            .then_with(|| other.node.cmp(&self.node))
-    }
-}
-
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
 /// Min-heap of [`Entry`] with lazy deletion (validity is judged by the caller).
+///
+/// A 4-ary implicit heap: half the levels of a binary heap, and a node's four children
+/// share one or two cache lines, so a pop touches about half as many lines on the large
+/// OPEN lists of a pose lattice (a binary heap's pop was a quarter of the search time).
+/// Entries are totally ordered (the node id breaks every tie), so the pop order — and
+/// hence the search — is the same as with any other correct priority queue.
 #[derive(Debug, Default)]
 pub(crate) struct OpenList {
-    heap: BinaryHeap<Entry>,
+    heap: Vec<Entry>,
+}
+
+/// Children per heap node.
+const ARITY: usize = 4;
+
+/// `a` pops before `b`.
+#[inline]
+fn before(a: &Entry, b: &Entry) -> bool {
+    (a.key, a.h, a.node) < (b.key, b.h, b.node)
 }
 
 impl OpenList {
@@ -55,11 +51,59 @@ impl OpenList {
 
     pub fn push(&mut self, entry: Entry) {
         self.heap.push(entry);
+        self.sift_up(self.heap.len() - 1);
+    }
+
+    fn sift_up(&mut self, mut i: usize) {
+        let e = self.heap[i];
+        while i > 0 {
+            let parent = (i - 1) / ARITY;
+            if !before(&e, &self.heap[parent]) {
+                break;
+            }
+            self.heap[i] = self.heap[parent];
+            i = parent;
+        }
+        self.heap[i] = e;
+    }
+
+    fn sift_down(&mut self, mut i: usize) {
+        let n = self.heap.len();
+        let e = self.heap[i];
+        loop {
+            let first = i * ARITY + 1;
+            if first >= n {
+                break;
+            }
+            let mut best = first;
+            for c in first + 1..(first + ARITY).min(n) {
+                if before(&self.heap[c], &self.heap[best]) {
+                    best = c;
+                }
+            }
+            if !before(&self.heap[best], &e) {
+                break;
+            }
+            self.heap[i] = self.heap[best];
+            i = best;
+        }
+        self.heap[i] = e;
+    }
+
+    /// Removes and returns the smallest entry.
+    fn pop(&mut self) -> Option<Entry> {
+        let last = self.heap.pop()?;
+        if self.heap.is_empty() {
+            return Some(last);
+        }
+        let top = std::mem::replace(&mut self.heap[0], last);
+        self.sift_down(0);
+        Some(top)
     }
 
     /// Pops entries until `valid` accepts one, which is returned (and removed).
     pub fn pop_valid(&mut self, mut valid: impl FnMut(&Entry) -> bool) -> Option<Entry> {
-        while let Some(e) = self.heap.pop() {
+        while let Some(e) = self.pop() {
             if valid(&e) {
                 return Some(e);
             }
@@ -70,11 +114,11 @@ impl OpenList {
     /// Discards stale entries at the top; returns the smallest valid entry, leaving it in
     /// the heap.
     pub fn peek_valid(&mut self, mut valid: impl FnMut(&Entry) -> bool) -> Option<Entry> {
-        while let Some(&e) = self.heap.peek() {
+        while let Some(&e) = self.heap.first() {
             if valid(&e) {
                 return Some(e);
             }
-            self.heap.pop();
+            self.pop();
         }
         None
     }
@@ -87,12 +131,18 @@ impl OpenList {
     /// Empties the heap, returning its entries (valid or stale) and keeping the
     /// allocation for [`OpenList::rebuild`].
     pub fn take_entries(&mut self) -> Vec<Entry> {
-        std::mem::take(&mut self.heap).into_vec()
+        std::mem::take(&mut self.heap)
     }
 
     /// Replaces the contents with `entries`, heapified in O(n).
     pub fn rebuild(&mut self, entries: Vec<Entry>) {
-        self.heap = BinaryHeap::from(entries);
+        self.heap = entries;
+        let n = self.heap.len();
+        if n > 1 {
+            for i in (0..=(n - 2) / ARITY).rev() {
+                self.sift_down(i);
+            }
+        }
     }
 
     #[cfg(test)]
@@ -114,6 +164,42 @@ mod tests {
         let order: Vec<_> =
             std::iter::from_fn(|| o.pop_valid(|_| true)).map(|e| (e.key, e.h, e.node)).collect();
         assert_eq!(order, vec![(3, 1, 4), (3, 1, 9), (3, 2, 7), (5, 0, 1), (9, 0, 0)]);
+    }
+
+    #[test]
+    fn pops_in_sorted_order_after_pushes_and_rebuilds() {
+        // A deterministic pseudo-random mix of pushes, pops and a rebuild against a
+        // sorted reference.
+        let mut o = OpenList::new();
+        let mut reference: Vec<(u64, u64, u32)> = Vec::new();
+        let mut x = 12345_u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for round in 0..2000 {
+            let r = next();
+            if r % 3 == 0 && !reference.is_empty() {
+                reference.sort_unstable();
+                let want = reference.remove(0);
+                let got = o.pop_valid(|_| true).map(|e| (e.key, e.h, e.node));
+                assert_eq!(got, Some(want));
+            } else {
+                let e = Entry { key: r % 50, h: (r >> 8) % 5, node: round };
+                reference.push((e.key, e.h, e.node));
+                o.push(e);
+            }
+            if round == 1000 {
+                let entries = o.take_entries();
+                o.rebuild(entries);
+            }
+        }
+        reference.sort_unstable();
+        let rest: Vec<_> =
+            std::iter::from_fn(|| o.pop_valid(|_| true)).map(|e| (e.key, e.h, e.node)).collect();
+        assert_eq!(rest, reference);
     }
 
     #[test]

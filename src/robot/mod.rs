@@ -104,6 +104,10 @@ pub struct RobotDescription {
     pub base_bottom_z: f64,
     /// Total mass, kg.
     pub total_mass: f64,
+    /// Mass of the base body alone (base, torso, arms, head: everything but the legs), kg.
+    pub body_mass: f64,
+    /// The base body's own CoM in the base frame, m.
+    pub body_com: [f64; 3],
 }
 
 impl RobotDescription {
@@ -129,6 +133,9 @@ impl RobotDescription {
             base_half_extents: [0.45, 0.25, 0.05],
             base_bottom_z: 0.0,
             total_mass: 58.0,
+            // Base box 15 kg at 0, torso 17 kg at z' = 0.30, head 2 kg at (0.02, 0, 0.63).
+            body_mass: 34.0,
+            body_com: [0.04 / 34.0, 0.0, 6.36 / 34.0],
         }
     }
 

@@ -118,6 +118,8 @@ pub(crate) fn describe(model: &MjModel) -> Result<RobotDescription, SimError> {
         base_half_extents,
         base_bottom_z,
         total_mass: model.body_subtreemass()[base],
+        body_mass: model.body_mass()[base],
+        body_com: model.body_ipos()[base],
     })
 }
 

@@ -1,0 +1,420 @@
+//! A lower bound on the step costs still needed to reach the goal: the informed part of
+//! the hybrid graph's heuristic ([`super::HybridGraph`]), computed once per plan.
+//!
+//! **Idea.** Every foot stands on a cell of finite foot cost C_F (eq. 1) in every state
+//! of the hybrid graph, and the only manoeuvre that carries a foot across untraversable
+//! terrain is an abstract step (Sec. V). So we split the finite-C_F cells into
+//! *components* — sets a foot can roll between without stepping — and lower-bound, per
+//! component and per foot, the sum of the step costs C_S (eq. 5, times the step-related
+//! factor) that foot still has to pay before it stands where the goal pose puts it. The
+//! four feet's bounds add up, because each step moves exactly one foot.
+//!
+//! **Components.** Two finite-C_F cells are *linked* when they are at most `R` cells
+//! apart along each axis (Chebyshev distance ≤ R); components are the connected sets of
+//! this relation. R bounds how far a foot's cell jumps in one manoeuvre that is not a
+//! step:
+//! - a driving move translates the base, hence every foot, by at most 2 cells per axis
+//!   (the 16- / 20-neighbourhood);
+//! - a turn on the spot moves a foot on a chord of `2 r sin(Δθ/2)` (r its distance from
+//!   the base centre, Δθ one orientation step), so its cell by at most
+//!   `⌈chord / res⌉` per axis;
+//! - a base shift leaves the feet where they stand up to the snap of the base to its
+//!   cell (half a cell diagonal, ≤ 1 cell per axis);
+//! - front foot forward and foot to neutral drive one foot along a line whose every
+//!   cell (sampled each `res`) has finite C_F: consecutive cells ≤ 1 apart per axis;
+//!
+//! with one cell added against float rounding: `R = max(2, ⌈chord / res⌉) + 1`. Both
+//! ends of each of these manoeuvres are finite-C_F cells (they are states' feet, or line
+//! cells checked finite), so they never change a foot's component.
+//!
+//! **Step edges between components.** A step of one foot from cell a (component A) to
+//! cell b (component B) costs `f · C_S` with `C_S = k7 · L + k8 · (C_F(b) − 1) + k9 · ΔH`
+//! (eq. 5; f the step-related factor). Each term is bounded below from the components
+//! alone:
+//! - `ΔH ≥ |H(b) − H(a)|` (ΔH_step is the largest height difference over the cells the
+//!   foot passes, the landing cell included) `≥ gap(A, B)`, the distance between the
+//!   components' height intervals `[min H, max H]`; a pair whose gap exceeds the largest
+//!   step height (criterion 3) has no step at all;
+//! - `C_F(b) ≥ min C_F over B`;
+//! - `L = d · res` with d ≥ 2 (the foot crosses at least one infinite cell and lands on
+//!   a finite one after it); between different components the cell centres are more
+//!   than R cells apart along some axis, so `|c_b − c_a| ≥ (R + 1) · res` and, with both
+//!   foot positions within half a cell diagonal of their cell centres,
+//!   `L ≥ (R + 1 − √2) · res`. On maps of at most [`MAX_DISTANCE_TRANSFORMS`]
+//!   components a tighter bound replaces it: the octile distance transform of each
+//!   component B gives the octile distance d from every cell to B, at most 1.0824 times
+//!   the Euclidean one, so a step from a near cell of A to B is at least
+//!   `min_a d / 1.0824 − √2` cells long (≈ 0.22 m between a floor and a 0.2 m platform,
+//!   whose untraversable band is 2 r_F wide);
+//! - a step starts only from a foot within `step_obstacle_distance_m` of an infinite
+//!   cell (criterion 1), so only components holding a cell of the graph's conservative
+//!   "near an obstacle" layer have outgoing step edges.
+//!
+//! Of the k7 term only the share `1 − λ` enters `w`: the share λ pays for the
+//! foot-offset potential of the hybrid heuristic ([`offset_potential`]).
+//!
+//! The component graph with these edge weights `w(A, B)` (B = A included) is searched
+//! backwards from the component of each goal foot (Dijkstra, dense, O(K²) for K
+//! components): `S_k(A)` is the cheapest chain of steps from A to foot k's goal
+//! component.
+//!
+//! **Consistency.** For a step of foot k from a ∈ A to b ∈ B: `S_k(A) ≤ w(A, B) + S_k(B)`
+//! (Dijkstra) `≤ c + S_k(B)`, and the other feet's terms do not change. Every other
+//! manoeuvre leaves all four components, hence the bound, unchanged. So `Σ_k S_k` is
+//! consistent on its own with respect to the step edges and invariant on all others; it
+//! is zero at the goal. Added to the driving heuristic (Euclidean distance plus turn,
+//! consistent with respect to drives, turns and base shifts and unchanged by steps and
+//! foot moves), the sum is consistent for every edge of the hybrid graph. Weights are
+//! rounded down to the micro-unit with a relative slack of 10⁻⁹ (edges round up), and
+//! the Dijkstra sums integers, so the bound holds exactly in fixed point.
+//!
+//! Maps with more than [`MAX_COMPONENTS`] components get no step bound (the bound is
+//! then zero everywhere, which is trivially consistent): the O(K²) search would cost
+//! more than it saves.
+//!
+//! **What the bound leaves out, and why.** Most of a platform plan's cost beyond the
+//! steps is driving with a foot close to an edge (C_F in the hundreds, eq. 1). A
+//! per-foot "rolling" bound (κ · C_F per metre a foot rolls, κ = k5 + k4/4 from eq. 4)
+//! would cover it for drives, turns and foot moves, but not for base shifts: a base
+//! shift snaps the base to the cell holding its exact end, so all four feet jump up to
+//! half a cell diagonal, repeatedly, for as little as `f · k10 · res` (one cell, C_B = 1).
+//! Consistency then caps the rolling weight at C_F ≈ 5, and base shifts are possible
+//! wherever a foot can come close to any obstacle (walls included), i.e. almost
+//! everywhere. The same cap (≈ 3.7 per metre) limits a per-cell bound on base motion
+//! taken from the driving pose costs. Neither is worth its set-up time.
+
+use crate::cost::{Cost as CostValue, CostMaps};
+use crate::planner::Cost;
+
+/// Largest number of components for which the step bound is computed.
+pub const MAX_COMPONENTS: usize = 2048;
+
+/// "No component": the cell's foot cost is not finite.
+const NONE: u32 = u32::MAX;
+
+/// The constants of the step cost the bound needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepBoundParams {
+    /// Factor on every step-related manoeuvre (Sec. V, Fig. 7).
+    pub step_cost_factor: f64,
+    /// k7 (eq. 5): weight on the step length.
+    pub k7: f64,
+    /// k8 (eq. 5): weight on the foothold cost.
+    pub k8: f64,
+    /// k9 (eq. 5): weight on the step height.
+    pub k9: f64,
+    /// Criterion 3: largest height difference of a step, m.
+    pub max_step_height_m: f64,
+    /// Link radius R, cells (see the module docs).
+    pub link_cells: usize,
+    /// k10: base shift weight (C_BS).
+    pub k10: f64,
+    /// k11 (eq. 6): single foot move weight.
+    pub k11: f64,
+}
+
+/// One component's summary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Component {
+    min_h: f64,
+    max_h: f64,
+    min_cf: f64,
+    /// Holds a cell of the "near an obstacle" layer: steps may start here.
+    near: bool,
+}
+
+/// Per-cell components and per-foot step bounds (see the module docs).
+#[derive(Debug, Clone)]
+pub struct StepBound {
+    /// Component per cell (row-major, as the height map), [`NONE`] where C_F is not finite.
+    comp: Vec<u32>,
+    /// Per foot (FL, FR, RL, RR), per component: the step cost still needed, S_k.
+    per_foot: [Vec<Cost>; 4],
+    components: usize,
+    /// Weight of the foot-offset potential per cell of offset, cost units.
+    offset_per_cell: f64,
+}
+
+impl StepBound {
+    /// A bound that is zero everywhere.
+    pub fn zero() -> Self {
+        Self { comp: Vec::new(), per_foot: Default::default(), components: 0, offset_per_cell: 0.0 }
+    }
+
+    /// Builds the bound on `maps` for the goal foot positions `goal_feet` (one array of
+    /// four per accepted goal orientation; foot k of every entry is a source for foot k).
+    /// `near` is the graph's per-cell "near an obstacle" layer (a superset of the cells
+    /// from which criterion 1 allows a step).
+    pub fn build(
+        maps: &CostMaps,
+        near: &[bool],
+        params: &StepBoundParams,
+        goal_feet: &[[[f64; 2]; 4]],
+    ) -> Self {
+        let hm = maps.heights();
+        let (nx, ny) = hm.dims();
+        let res = hm.resolution();
+        let r = params.link_cells.max(1) as isize;
+        let finite = |i: usize, j: usize| match maps.foot_cost_cell(i, j) {
+            CostValue::Finite(c) => hm.get(i, j).map(|h| (c, h)),
+            _ => None,
+        };
+        // Components: breadth-first over linked finite cells.
+        let mut comp = vec![NONE; nx * ny];
+        let mut comps: Vec<Component> = Vec::new();
+        let mut queue = Vec::new();
+        for j0 in 0..ny {
+            for i0 in 0..nx {
+                if comp[j0 * nx + i0] != NONE {
+                    continue;
+                }
+                let Some((cf, h)) = finite(i0, j0) else { continue };
+                if comps.len() >= MAX_COMPONENTS {
+                    return Self::zero();
+                }
+                let id = comps.len() as u32;
+                let mut c = Component { min_h: h, max_h: h, min_cf: cf, near: false };
+                comp[j0 * nx + i0] = id;
+                queue.clear();
+                queue.push((i0, j0));
+                while let Some((i, j)) = queue.pop() {
+                    let (cf, h) = finite(i, j).unwrap_or((f64::INFINITY, f64::NAN));
+                    c.min_h = c.min_h.min(h);
+                    c.max_h = c.max_h.max(h);
+                    c.min_cf = c.min_cf.min(cf);
+                    c.near |= near.get(j * nx + i).copied().unwrap_or(false);
+                    let (i, j) = (i as isize, j as isize);
+                    for b in (j - r).max(0)..=(j + r).min(ny as isize - 1) {
+                        for a in (i - r).max(0)..=(i + r).min(nx as isize - 1) {
+                            let k = b as usize * nx + a as usize;
+                            if comp[k] == NONE && finite(a as usize, b as usize).is_some() {
+                                comp[k] = id;
+                                queue.push((a as usize, b as usize));
+                            }
+                        }
+                    }
+                }
+                comps.push(c);
+            }
+        }
+        let k = comps.len();
+        let l_other = ((r as f64 + 1.0 - std::f64::consts::SQRT_2) * res).max(2.0 * res);
+        let l_same = 2.0 * res;
+        let gaps = min_step_lengths(&comp, &comps, nx, ny, res, near);
+        let min_cf = comps.iter().map(|c| c.min_cf).fold(f64::INFINITY, f64::min);
+        let (offset_per_m, lambda) = offset_potential(params, min_cf);
+        let k7 = params.k7 * (1.0 - lambda);
+        let weight = |a: usize, b: usize| -> Option<Cost> {
+            let (ca, cb) = (&comps[a], &comps[b]);
+            if !ca.near {
+                return None;
+            }
+            let gap = (cb.min_h - ca.max_h).max(ca.min_h - cb.max_h).max(0.0);
+            if gap > params.max_step_height_m {
+                return None;
+            }
+            let l = if a == b {
+                l_same
+            } else {
+                gaps.as_ref().map_or(l_other, |g| g.get(a, b)).max(l_other)
+            };
+            let c_s = k7 * l + params.k8 * (cb.min_cf - 1.0) + params.k9 * gap;
+            Some(Cost::from_f64_floor(params.step_cost_factor * c_s * (1.0 - 1e-9)))
+        };
+        let per_foot = std::array::from_fn(|foot| {
+            let mut dist = vec![Cost::INFINITY; k];
+            for feet in goal_feet {
+                let [x, y] = feet[foot];
+                if let Some((i, j)) = hm.cell_of(x, y) {
+                    let c = comp[j * nx + i];
+                    if c != NONE {
+                        dist[c as usize] = Cost::ZERO;
+                    }
+                }
+            }
+            // Dense Dijkstra over the component graph, edges reversed.
+            let mut done = vec![false; k];
+            loop {
+                let next = (0..k)
+                    .filter(|&c| !done[c] && !dist[c].is_infinite())
+                    .min_by_key(|&c| (dist[c], c));
+                let Some(b) = next else { break };
+                done[b] = true;
+                for a in 0..k {
+                    if done[a] {
+                        continue;
+                    }
+                    if let Some(w) = weight(a, b) {
+                        let d = dist[b].saturating_add(w);
+                        if d < dist[a] {
+                            dist[a] = d;
+                        }
+                    }
+                }
+            }
+            dist
+        });
+        Self { comp, per_foot, components: k, offset_per_cell: offset_per_m * res }
+    }
+
+    /// The weight c of the foot-offset potential, per metre of offset.
+    pub fn offset_weight_per_m(&self, res: f64) -> f64 {
+        self.offset_per_cell / res
+    }
+
+    /// Number of components (0 for the zero bound).
+    pub fn components(&self) -> usize {
+        self.components
+    }
+
+    /// Σ_k S_k over the feet at world positions `feet` (FL, FR, RL, RR) on the map of
+    /// `maps`: the step cost still needed. A foot off the map or on a cell of non-finite
+    /// foot cost adds nothing; a foot that cannot reach its goal component makes the
+    /// bound [`Cost::INFINITY`].
+    #[inline]
+    pub fn lower_bound(&self, maps: &CostMaps, feet: &[[f64; 2]; 4]) -> Cost {
+        if self.components == 0 {
+            return Cost::ZERO;
+        }
+        let hm = maps.heights();
+        let mut sum = Cost::ZERO;
+        for (k, f) in feet.iter().enumerate() {
+            let Some((i, j)) = hm.cell_of(f[0], f[1]) else { continue };
+            let c = self.comp[j * hm.nx() + i];
+            if c != NONE {
+                sum = sum.saturating_add(self.per_foot[k][c as usize]);
+            }
+        }
+        sum
+    }
+
+    /// The foot-offset potential Φ = c · Σ_k |o_k| of a footprint with offsets `o`
+    /// (cells), rounded down (see [`offset_potential`]).
+    #[inline]
+    pub fn offset_potential(&self, o: &[i8; 4]) -> Cost {
+        let cells: i32 = o.iter().map(|&v| i32::from(v).abs()).sum();
+        Cost::from_f64_floor(self.offset_per_cell * f64::from(cells) * (1.0 - 1e-9))
+    }
+}
+
+/// Lower bounds on step lengths between components, from octile distance transforms.
+struct StepLengths {
+    /// Row-major `[a · k + b]`, m.
+    lengths: Vec<f64>,
+    k: usize,
+}
+
+impl StepLengths {
+    fn get(&self, a: usize, b: usize) -> f64 {
+        self.lengths[a * self.k + b]
+    }
+}
+
+/// Largest number of components for which `min_step_lengths` runs a distance transform
+/// per component (each is two passes over the map).
+pub const MAX_DISTANCE_TRANSFORMS: usize = 32;
+
+/// For every pair (A, B) of components: a lower bound on the length L of a step from a
+/// cell of A flagged `near` to a cell of B, `d / 1.0824 − √2 · res` with d the octile
+/// distance between their cell centres (the octile distance is at most 1.0824 times the
+/// Euclidean one; the feet lie within half a cell diagonal of their cell centres).
+/// `None` for maps with more than [`MAX_DISTANCE_TRANSFORMS`] components.
+fn min_step_lengths(
+    comp: &[u32],
+    comps: &[Component],
+    nx: usize,
+    ny: usize,
+    res: f64,
+    near: &[bool],
+) -> Option<StepLengths> {
+    let k = comps.len();
+    if k > MAX_DISTANCE_TRANSFORMS {
+        return None;
+    }
+    let octile_over_euclid = (1.0 + (std::f64::consts::SQRT_2 - 1.0).powi(2)).sqrt();
+    let mut lengths = vec![0.0; k * k];
+    let mut d = vec![0.0_f64; nx * ny];
+    let diag = std::f64::consts::SQRT_2;
+    for b in 0..k {
+        for (v, &c) in d.iter_mut().zip(comp) {
+            *v = if c == b as u32 { 0.0 } else { f64::INFINITY };
+        }
+        // Two-pass chamfer transform with weights 1 and √2: the exact octile distance
+        // to the nearest cell of B.
+        for j in 0..ny {
+            for i in 0..nx {
+                let mut v = d[j * nx + i];
+                if i > 0 {
+                    v = v.min(d[j * nx + i - 1] + 1.0);
+                }
+                if j > 0 {
+                    v = v.min(d[(j - 1) * nx + i] + 1.0);
+                    if i > 0 {
+                        v = v.min(d[(j - 1) * nx + i - 1] + diag);
+                    }
+                    if i + 1 < nx {
+                        v = v.min(d[(j - 1) * nx + i + 1] + diag);
+                    }
+                }
+                d[j * nx + i] = v;
+            }
+        }
+        for j in (0..ny).rev() {
+            for i in (0..nx).rev() {
+                let mut v = d[j * nx + i];
+                if i + 1 < nx {
+                    v = v.min(d[j * nx + i + 1] + 1.0);
+                }
+                if j + 1 < ny {
+                    v = v.min(d[(j + 1) * nx + i] + 1.0);
+                    if i + 1 < nx {
+                        v = v.min(d[(j + 1) * nx + i + 1] + diag);
+                    }
+                    if i > 0 {
+                        v = v.min(d[(j + 1) * nx + i - 1] + diag);
+                    }
+                }
+                d[j * nx + i] = v;
+            }
+        }
+        let mut best = vec![f64::INFINITY; k];
+        for ((&c, &v), &n) in comp.iter().zip(&d).zip(near) {
+            if n && c != NONE && v < best[c as usize] {
+                best[c as usize] = v;
+            }
+        }
+        for a in 0..k {
+            let cells = best[a] / octile_over_euclid - diag;
+            lengths[a * k + b] = (cells * res * (1.0 - 1e-9)).max(0.0);
+        }
+    }
+    Some(StepLengths { lengths, k })
+}
+
+/// The weight c of the foot-offset potential `Φ = c · Σ_k |o_k|` (o_k in metres) that the
+/// hybrid heuristic adds for non-neutral footprints: every offset must be undone before
+/// the (neutral) goal. The largest `c` for which Φ stays consistent:
+///
+/// - foot to neutral / front foot forward drive one foot by |Δo| at cost
+///   `f · k11 · |Δo| · C_F,avg ≥ f · k11 · C_F,min · |Δo|` (eq. 6);
+/// - a base shift by L changes every offset by L (Φ drops by at most 4 c L) and the
+///   Euclidean part of the heuristic by at most the base's move, ≤ L + res/√2 (the snap
+///   to the cell); it costs at least `f · k10 · L` (C_B ≥ 1, eq. 3) and L ≥ res, so
+///   `4 c ≤ f · k10 − 1 − 1/√2` suffices;
+/// - a step changes one offset by L and costs at least `f · k7 · L` beyond what the step
+///   bound uses when the bound keeps only `(1 − λ) · k7`: `c ≤ λ · f · k7`;
+/// - drives and turns keep the neutral footprint (Φ = 0).
+///
+/// Returns `(c, λ)` with λ the smallest share of k7 that pays for c (c = 0 when the
+/// constants leave no room). `min_foot_cost` is the smallest finite C_F of the map.
+pub fn offset_potential(params: &StepBoundParams, min_foot_cost: f64) -> (f64, f64) {
+    let f = params.step_cost_factor;
+    let c = (f * params.k11 * min_foot_cost)
+        .min((f * params.k10 - 1.0 - std::f64::consts::FRAC_1_SQRT_2) / 4.0)
+        .min(f * params.k7);
+    if !(c.is_finite() && c > 0.0) {
+        return (0.0, 0.0);
+    }
+    // c ≤ f · k7 here, so λ ≤ 1.
+    (c, (c / (f * params.k7)).min(1.0))
+}
