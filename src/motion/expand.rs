@@ -589,7 +589,8 @@ impl Expander<'_> {
                                 candidates.push((h, wf, rf, Shift::Remainder(f)));
                             }
                         } else {
-                            for m in [0.025, 0.05, 0.1, 0.15, 0.2, -0.025, -0.05, -0.1, -0.15, -0.2] {
+                            for m in [0.025, 0.05, 0.1, 0.15, 0.2, -0.025, -0.05, -0.1, -0.15, -0.2]
+                            {
                                 candidates.push((h, wf, rf, Shift::Fixed(m)));
                             }
                         }
