@@ -465,12 +465,10 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
         Command::Run { scenario, planner, noise, rerun, json, model } => {
             let sc = load(&scenario)?;
             let opts = jobs::run::RunOptions {
-                plan: planner.options(),
-                follower: crate::control::path_follower::FollowerConfig::default(),
-                model_path: model.model,
                 rerun,
                 progress: !json,
                 noise,
+                ..jobs::run::RunOptions::new(planner.options(), model.model)
             };
             let s = jobs::run::run(&sc, &opts).map_err(run_error)?;
             if json {
@@ -490,6 +488,16 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                     s.goal_heading_error_rad.to_degrees()
                 );
                 say!("stability margin    min {:.3} m", s.min_stability_margin_m);
+                say!(
+                    "steps               {} of {} executed, {} aborted, {} replans",
+                    s.steps_executed,
+                    s.steps_planned,
+                    s.steps_aborted,
+                    s.replans
+                );
+                if let Some(f) = &s.failure {
+                    say!("stopped             {f}");
+                }
                 say!(
                     "tracking error      max {:.3} m, mean {:.3} m",
                     s.max_tracking_error_m,
@@ -529,14 +537,7 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             }
             for file in &files {
                 let sc = load(file)?;
-                let opts = jobs::run::RunOptions {
-                    plan: planner.options(),
-                    follower: crate::control::path_follower::FollowerConfig::default(),
-                    model_path: model.model.clone(),
-                    rerun: None,
-                    progress: false,
-                    noise: None,
-                };
+                let opts = jobs::run::RunOptions::new(planner.options(), model.model.clone());
                 let row = match jobs::run::run(&sc, &opts) {
                     Ok(s) => {
                         if !json {
@@ -554,11 +555,13 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                         serde_json::to_value(&s).context("serialising")?
                     }
                     Err(e) => {
+                        // The whole cause chain: "step motion generation: path element …".
+                        let e = format!("{:#}", run_error(e));
                         if !json {
                             say!("{:<16} {:<7} {e}", sc.name, "ERROR");
                         }
                         all_passed = false;
-                        serde_json::json!({ "scenario": sc.name, "passed": false, "error": e.to_string() })
+                        serde_json::json!({ "scenario": sc.name, "passed": false, "error": e })
                     }
                 };
                 rows.push(row);

@@ -88,6 +88,11 @@ pub struct Params {
     pub base_pitch_slope_fraction: f64,
     /// Minimum static stability margin accepted for a keyframe (m).
     pub min_stability_margin_m: f64,
+    /// Support margin measured in the simulation (CoM over the wheel contacts of the three
+    /// support legs) required before a foot is lifted, m (the executor's closed loop on
+    /// stability, issue 7): 2 cm, the smallest margin the paper's scenarios expect during
+    /// execution.
+    pub min_lift_margin_m: f64,
     /// Longest wheel-to-centre move of the stepping side's other wheel pair (Sec. VI-A,
     /// Fig. 12a), m. Ours: 0.45 m.
     pub max_wheel_to_centre_m: f64,
@@ -138,6 +143,7 @@ impl Default for Params {
             manoeuvre_leg_height_m: 0.45,
             base_pitch_slope_fraction: 0.7,
             min_stability_margin_m: 0.03,
+            min_lift_margin_m: 0.02,
             max_wheel_to_centre_m: 0.45,
             wheel_gap_m: 0.3,
             step_support_margin_m: 0.04,
@@ -188,7 +194,7 @@ impl Params {
                 return Err(InvalidParam { name, value, reason: "must be a finite number > 0" });
             }
         }
-        let non_negative: [(&'static str, f64); 13] = [
+        let non_negative: [(&'static str, f64); 14] = [
             ("k1", self.k1),
             ("k2", self.k2),
             ("k3", self.k3),
@@ -202,6 +208,7 @@ impl Params {
             ("k11", self.k11),
             ("base_pitch_slope_fraction", self.base_pitch_slope_fraction),
             ("min_stability_margin_m", self.min_stability_margin_m),
+            ("min_lift_margin_m", self.min_lift_margin_m),
         ];
         for (name, value) in non_negative {
             if !(value.is_finite() && value >= 0.0) {

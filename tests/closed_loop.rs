@@ -3,7 +3,6 @@
 
 mod common;
 
-use momaro::control::path_follower::FollowerConfig;
 use momaro::jobs::plan::PlanOptions;
 use momaro::jobs::run::{PoseNoise, RunOptions, RunSummary, run};
 
@@ -11,14 +10,7 @@ fn run_scenario(name: &str, noise: Option<PoseNoise>) -> RunSummary {
     let sc = common::scenario(name);
     // A generous planning budget: CI machines are slow and this is not a speed test.
     let plan = PlanOptions { time_limit_s: 60.0, ..PlanOptions::default() };
-    let opts = RunOptions {
-        plan,
-        follower: FollowerConfig::default(),
-        model_path: common::model(),
-        rerun: None,
-        progress: false,
-        noise,
-    };
+    let opts = RunOptions { noise, ..RunOptions::new(plan, common::model()) };
     let s = run(&sc, &opts).expect("run completes");
     assert!(s.passed, "{name}: expectations failed: {s:#?}");
     assert!(

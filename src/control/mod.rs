@@ -1,7 +1,10 @@
 //! Controllers that turn plans and commands into actuator targets: wheel kinematics for
-//! omnidirectional driving and the standing posture.
+//! omnidirectional driving, the standing posture, the path follower, and the step
+//! executor with its foot contact confirmation.
 
 pub mod bspline;
+pub mod foot_contact;
 pub mod path_follower;
 pub mod stand;
+pub mod step_executor;
 pub mod wheels;

@@ -46,6 +46,14 @@ pub fn record(
     }
     let poses: Vec<_> = summary.path.iter().map(|e| e.pose).collect();
     rec.log_plan(&poses)?;
+    rec.log_steps(&step_lines(summary))?;
+    rec.finish()?;
+    Ok(())
+}
+
+/// Each step of `summary`'s path as a line from the old foot position to its foothold, 2 cm
+/// above the ground, and whether a front leg steps (red) or a rear one (green).
+pub fn step_lines(summary: &PlanSummary) -> Vec<([f64; 3], [f64; 3], bool)> {
     let mut steps = Vec::new();
     for pair in summary.path.windows(2) {
         let (before, after) = (&pair[0], &pair[1]);
@@ -61,7 +69,5 @@ pub fn record(
             ));
         }
     }
-    rec.log_steps(&steps)?;
-    rec.finish()?;
-    Ok(())
+    steps
 }

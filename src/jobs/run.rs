@@ -1,29 +1,33 @@
-//! `momaro run`: plan a scenario, then execute the plan in closed loop in MuJoCo until the
-//! goal is reached or the scenario's time budget runs out (paper Sec. IX).
+//! `momaro run`: plan a scenario, expand the plan into keyframes (step motion generation,
+//! Sec. VI), then execute it in closed loop in MuJoCo until the goal is reached or the
+//! scenario's time budget runs out (paper Sec. IX, issue 7).
 //!
-//! Each 10 ms control tick: the measured base pose (optionally with seeded noise) goes to
-//! the B-spline path follower, whose twist goes through the omnidirectional wheel
-//! kinematics to steering and wheel targets; leg joint targets come from the driving
-//! posture of `motion::kinematics` (each foot on the height map's ground, the base pitched by
-//! 70 % of the slope under the feet, Sec. VI-B), so the robot follows ramps. The stability monitor measures the margin
-//! of MuJoCo's CoM over the wheels MuJoCo reports in contact. The scenario's expectations
-//! decide the verdict.
-//!
-//! Executing abstract steps (issue 7) is not built yet: a plan with steps is reported as a
-//! clear error, not driven.
+//! Each 10 ms control tick the step executor (`control::step_executor`) gets the measured
+//! base pose (optionally with seeded noise), joints, steering, MuJoCo's CoM and the wheels
+//! MuJoCo reports in contact, and returns leg, steering and wheel targets: drive runs with
+//! the B-spline path follower, steps and other manoeuvres by tracking the keyframes, with
+//! the margin checked before each lift and contact confirmed before weight goes back onto
+//! a placed foot. When the executor leaves the plan (step aborted or failed, drift), the
+//! robot returns to the driving posture and the job replans from the simulated pose
+//! (ARA*, time-limited; a bounded number of times). The stability monitor measures the
+//! margin of MuJoCo's CoM over the wheels in contact; the scenario's expectations decide
+//! the verdict.
 
-use super::plan::{self, PathKind, PlanJobError, PlanOptions, PlanSummary};
+use super::plan::{self, PlanJobError, PlanOptions, PlanSummary};
 use super::sim::{CONTROL_HZ, SETTLE_S};
-use crate::control::path_follower::{FollowerConfig, FollowerError, FollowerStatus, PathFollower};
-use crate::control::wheels::WheelKinematics;
+use crate::control::path_follower::FollowerConfig;
+use crate::control::step_executor::{
+    ExecEvent, ExecStatus, ExecutorConfig, Observation, StepExecutor,
+};
 use crate::geometry::{Pose2, wrap_angle};
 use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor};
-use crate::motion::kinematics::{driving_posture, leg_joint_targets};
+use crate::motion::{DetailedPath, MotionError, MotionOptions, Phase, expand_path};
 use crate::progress::SimProgress;
 use crate::robot::Leg;
 use crate::robot::ik::IkError;
 use crate::scenario::{Scenario, Stepping};
 use crate::sim::{SimError, Simulation};
+use crate::terrain::HeightMap;
 use crate::viz::{Recorder, VizError};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -36,15 +40,13 @@ pub enum RunJobError {
     /// Planning failed.
     #[error(transparent)]
     Plan(#[from] PlanJobError),
-    /// The plan contains steps, which the executor cannot do yet.
-    #[error(
-        "{scenario}: the plan contains {steps} steps; executing steps is not implemented yet (issue 7)"
-    )]
-    SteppingUnsupported {
+    /// The plan could not be expanded into keyframes (step motion generation).
+    #[error("{scenario}: step motion generation")]
+    Motion {
         /// Scenario name.
         scenario: String,
-        /// Steps in the plan.
-        steps: usize,
+        /// The cause.
+        source: MotionError,
     },
     /// The height map could not be built.
     #[error(transparent)]
@@ -60,9 +62,6 @@ pub enum RunJobError {
         /// y, m.
         y: f64,
     },
-    /// The follower rejected the path or its configuration.
-    #[error("path follower: {0}")]
-    Follower(#[from] FollowerError),
     /// The simulation failed.
     #[error(transparent)]
     Sim(#[from] SimError),
@@ -100,6 +99,84 @@ pub struct RunOptions {
     pub progress: bool,
     /// Noise on the pose feedback.
     pub noise: Option<PoseNoise>,
+    /// Replans allowed when the executor leaves the plan.
+    pub max_replans: usize,
+    /// Planning budget of a replan, s (wall time; the simulation waits).
+    pub replan_time_limit_s: f64,
+    /// A push on the base during a step (disturbance tests).
+    pub push: Option<Push>,
+}
+
+impl RunOptions {
+    /// Defaults for a scenario run: the given planner options, the default follower, two
+    /// replans of at most 20 s each, no noise, recording or push.
+    pub fn new(plan: PlanOptions, model_path: PathBuf) -> Self {
+        Self {
+            plan,
+            follower: FollowerConfig::default(),
+            model_path,
+            rerun: None,
+            progress: false,
+            noise: None,
+            max_replans: 2,
+            replan_time_limit_s: 20.0,
+            push: None,
+        }
+    }
+}
+
+/// When a push starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PushWhen {
+    /// At a simulated time, s.
+    At(f64),
+    /// During a step of the first plan.
+    Step {
+        /// The step (1-based, in execution order).
+        step: usize,
+        /// The phase of that step in which the push starts.
+        phase: Phase,
+        /// Delay after the phase starts, s.
+        delay_s: f64,
+    },
+}
+
+/// A force on the base for a while (disturbance tests).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Push {
+    /// When it starts.
+    pub when: PushWhen,
+    /// Force in the world frame, N.
+    pub force: [f64; 3],
+    /// Duration, s.
+    pub duration_s: f64,
+}
+
+/// What a push did.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PushReport {
+    /// When the push started, s.
+    pub start_s: f64,
+    /// Measured margin just before it, m.
+    pub margin_before_m: f64,
+    /// Smallest measured margin from the push start until 2 s after its end, m.
+    pub min_margin_after_m: f64,
+    /// Time the measured margin was negative in that window, s.
+    pub negative_margin_s: f64,
+    /// Largest |roll| or |pitch| in that window, degrees.
+    pub max_tilt_deg: f64,
+}
+
+/// The smallest measured margin while one step's foot was off its support (from the lift
+/// to the confirmed contact).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StepMargin {
+    /// Step number (execution order, 1-based).
+    pub step: usize,
+    /// The leg.
+    pub leg: Leg,
+    /// Smallest measured margin, m.
+    pub min_margin_m: f64,
 }
 
 /// One expectation of the scenario and whether the run met it.
@@ -138,8 +215,24 @@ pub struct RunSummary {
     pub plan_cost: f64,
     /// Steps in the plan.
     pub plan_steps: usize,
-    /// Steps executed.
+    /// Steps executed (placed foot confirmed in contact).
     pub steps_executed: usize,
+    /// Steps planned over the run: those of the last plan plus those executed before it.
+    pub steps_planned: usize,
+    /// Steps aborted before lifting or failed.
+    pub steps_aborted: usize,
+    /// Replans.
+    pub replans: usize,
+    /// Keyframes of the first detailed plan.
+    pub keyframes: usize,
+    /// Smallest measured margin during each executed or attempted step.
+    pub step_margins: Vec<StepMargin>,
+    /// What the executor did (lifts, corrections, steps, failures).
+    pub executor_events: Vec<ExecEvent>,
+    /// Why the run stopped early, if it did (replan failed, replans exhausted).
+    pub failure: Option<String>,
+    /// The push and the margins around it, if one was applied.
+    pub push: Option<PushReport>,
     /// Smallest measured stability margin after settling, m.
     pub min_stability_margin_m: f64,
     /// A tip-over was seen.
@@ -152,6 +245,8 @@ pub struct RunSummary {
     pub mean_tracking_error_m: f64,
     /// Largest |base pitch| seen, degrees.
     pub max_pitch_deg: f64,
+    /// Largest |roll| or |pitch| seen after settling, degrees.
+    pub max_tilt_deg: f64,
     /// The expectations and their results.
     pub expectations: Vec<ExpectationResult>,
     /// Monitor events.
@@ -201,11 +296,21 @@ fn expectations(scenario: &Scenario, s: &RunSummary) -> Vec<ExpectationResult> {
     }
     match e.stepping {
         Stepping::Any => {}
-        Stepping::Required => out.push(ExpectationResult {
-            name: "stepping",
-            passed: s.plan_steps > 0,
-            detail: format!("{} steps planned, steps required", s.plan_steps),
-        }),
+        Stepping::Required => {
+            out.push(ExpectationResult {
+                name: "stepping",
+                passed: s.plan_steps > 0,
+                detail: format!("{} steps planned, steps required", s.plan_steps),
+            });
+            out.push(ExpectationResult {
+                name: "steps_executed",
+                passed: s.steps_planned > 0 && s.steps_executed == s.steps_planned,
+                detail: format!(
+                    "{} of {} steps executed, {} aborted, {} replans",
+                    s.steps_executed, s.steps_planned, s.steps_aborted, s.replans
+                ),
+            });
+        }
         Stepping::Forbidden => out.push(ExpectationResult {
             name: "stepping",
             passed: s.plan_steps == 0,
@@ -237,32 +342,125 @@ fn expectations(scenario: &Scenario, s: &RunSummary) -> Vec<ExpectationResult> {
     out
 }
 
-/// Plans and executes `scenario` in closed loop.
+/// A plan and its expansion into keyframes.
+#[derive(Debug, Clone)]
+pub struct Mission {
+    /// The abstract plan.
+    pub plan: PlanSummary,
+    /// Its keyframes.
+    pub detailed: DetailedPath,
+}
+
+/// Plans `scenario` from its start and expands the path with `sim`'s CoM model.
 ///
 /// # Errors
-/// [`RunJobError`] if planning fails, the plan needs steps, or the simulation fails.
+/// Planning or the expansion failed.
+pub fn plan_mission(
+    scenario: &Scenario,
+    sim: &mut Simulation,
+    opts: &PlanOptions,
+) -> Result<Mission, RunJobError> {
+    let robot = sim.robot().clone();
+    let plan = plan::run(scenario, &robot, opts)?;
+    let detailed = expand_mission(scenario, sim, &plan, plan.path.len())?;
+    Ok(Mission { plan, detailed })
+}
+
+/// Expands the first `end` elements of `plan`'s path (the whole path for its length).
+///
+/// # Errors
+/// The maps cannot be built or the expansion fails.
+pub fn expand_mission(
+    scenario: &Scenario,
+    sim: &mut Simulation,
+    plan: &PlanSummary,
+    end: usize,
+) -> Result<DetailedPath, RunJobError> {
+    let robot = sim.robot().clone();
+    let prep = plan::prepare(scenario, &robot, Some(plan.k12), Some(plan.step_cost_factor))?;
+    let options = MotionOptions::from_params(&prep.params);
+    let end = end.min(plan.path.len());
+    expand_path(&plan.path[..end], &robot, &prep.maps, sim, &options)
+        .map_err(|source| RunJobError::Motion { scenario: scenario.name.clone(), source })
+}
+
+/// Plans, expands and executes `scenario` in closed loop.
+///
+/// # Errors
+/// [`RunJobError`] if planning or the expansion fails or the simulation fails.
 pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobError> {
     let wall = Instant::now();
     let mut sim = Simulation::new(scenario, &opts.model_path)?;
-    let robot = sim.robot().clone();
-    let plan: PlanSummary = plan::run(scenario, &robot, &opts.plan)?;
-    if plan.steps > 0 {
-        return Err(RunJobError::SteppingUnsupported {
-            scenario: scenario.name.clone(),
-            steps: plan.steps,
-        });
-    }
-    let heights = super::costmap::rasterised_map(scenario)?;
-    let poses: Vec<Pose2> = plan
-        .path
-        .iter()
-        .filter(|e| matches!(e.kind, PathKind::Start | PathKind::Drive | PathKind::Turn))
-        .map(|e| e.pose)
-        .collect();
-    let mut follower = PathFollower::new(poses.clone(), opts.follower.clone())?;
+    let mission = plan_mission(scenario, &mut sim, &opts.plan)?;
     super::stand_at_start(&mut sim, scenario)?;
+    execute(scenario, &mut sim, mission, opts, wall)
+}
 
+/// An error and its sources, joined by ": ".
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut cur = e.source();
+    while let Some(c) = cur {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        cur = c.source();
+    }
+    s
+}
+
+/// What the executor sees of the simulation, with `measured` as the base pose.
+fn observe(sim: &Simulation, measured: Pose2) -> Observation {
+    Observation {
+        time: sim.time(),
+        base: measured,
+        joints: Leg::ALL.map(|l| sim.leg_joints(l)),
+        steering: Leg::ALL.map(|l| sim.steering_angle(l)),
+        steering_rate: Leg::ALL.map(|l| sim.steering_rate(l)),
+        wheel_angles: Leg::ALL.map(|l| sim.wheel_angles(l)),
+        com: sim.center_of_mass(),
+        wheel_contacts: sim
+            .wheel_contacts()
+            .iter()
+            .map(|c| (c.leg, [c.position[0], c.position[1]]))
+            .collect(),
+    }
+}
+
+fn log_mission(r: &Recorder, m: &Mission) -> Result<(), VizError> {
+    let poses: Vec<Pose2> = m.plan.path.iter().map(|e| e.pose).collect();
+    r.log_plan(&poses)?;
+    r.log_steps(&super::plan_recording::step_lines(&m.plan))?;
+    r.log_keyframes(&m.detailed.keyframes)
+}
+
+/// Executes `mission` in `sim` from its current state (the robot standing at the plan's
+/// start), replanning when the executor leaves the plan; `wall` is when the job started.
+///
+/// # Errors
+/// [`RunJobError`] if the maps cannot be built, the simulation diverges or the recording
+/// fails. A run that fails its expectations is a summary with `passed = false`.
+#[allow(clippy::too_many_lines)]
+pub fn execute(
+    scenario: &Scenario,
+    sim: &mut Simulation,
+    mission: Mission,
+    opts: &RunOptions,
+    wall: Instant,
+) -> Result<RunSummary, RunJobError> {
+    let robot = sim.robot().clone();
+    let heights: HeightMap = super::costmap::rasterised_map(scenario)?;
     let params = &scenario.params;
+    let config = ExecutorConfig::from_params(params, opts.follower.clone());
+    let first_plan = (mission.plan.cost, mission.plan.steps, mission.detailed.keyframes.len());
+    let mut planning_time_s = mission.plan.planning_time_s;
+    let mut steps_planned = mission.detailed.steps;
+    let mut exec = StepExecutor::new(
+        &robot,
+        config.clone(),
+        mission.detailed.keyframes.clone(),
+        heights.clone(),
+    );
+
     let mut recorder = match &opts.rerun {
         Some(path) => {
             let mut r = Recorder::create(path, "momaro run")?;
@@ -274,7 +472,7 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
             if let Some(img) = crate::cost_image::cost_layer_image(&foot, nx, ny, None) {
                 r.log_layer_image("foot_cost", &img, heights.origin(), heights.resolution())?;
             }
-            r.log_plan(&poses)?;
+            log_mission(&r, &mission)?;
             Some(r)
         }
         None => None,
@@ -283,15 +481,24 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
     let dt = sim.timestep();
     let substeps = ((1.0 / CONTROL_HZ) / dt).round().max(1.0) as usize;
     let control_dt = substeps as f64 * dt;
-    let kin = WheelKinematics::default();
-    let feet = robot.neutral_footprint();
     let mut monitor = StabilityMonitor::new(MonitorLimits::default());
     let mut noise = opts.noise.map(|n| (n, Noise::new(n.seed)));
     let timeout = scenario.expect.timeout_s;
     let progress = SimProgress::new(&scenario.name, timeout, opts.progress);
     let (mut max_track, mut sum_track, mut n_track, mut max_pitch) = (0.0f64, 0.0, 0usize, 0.0f64);
     let exec_wall = Instant::now();
+    let mut replan_wall = 0.0;
     let mut finished = false;
+    let mut failure = None;
+    let mut replans = 0;
+    // Counters of executors replaced by a replan.
+    let (mut done_executed, mut done_aborted, mut done_events) = (0, 0, Vec::new());
+    let mut step_margins: Vec<StepMargin> = Vec::new();
+    let mut step_key: Option<(usize, usize)> = None;
+    // Push: phase start, push start, margin before, min margin after.
+    let mut push_phase_start: Option<f64> = None;
+    let mut push_report: Option<PushReport> = None;
+    let mut last_margin = f64::INFINITY;
     let mut tick = 0usize;
     while sim.time() < timeout {
         let base = sim.base();
@@ -304,38 +511,123 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
             ),
             None => truth,
         };
-        let out = follower.update(measured, control_dt);
-        if out.status == FollowerStatus::Finished {
-            finished = true;
-            break;
+        let obs = observe(sim, measured);
+        let (cmd, status) = exec.tick(&obs, control_dt);
+        match status {
+            ExecStatus::Finished => {
+                finished = true;
+                break;
+            }
+            ExecStatus::NeedsReplan(f) => {
+                if replans >= opts.max_replans {
+                    failure = Some(format!("{f}; no replans left ({replans} used)"));
+                    break;
+                }
+                replans += 1;
+                let t = Instant::now();
+                let mut from_here = scenario.clone();
+                from_here.start = truth;
+                let replan_opts =
+                    PlanOptions { time_limit_s: opts.replan_time_limit_s, ..opts.plan.clone() };
+                let result = plan_mission(&from_here, sim, &replan_opts);
+                replan_wall += t.elapsed().as_secs_f64();
+                match result {
+                    Ok(m) => {
+                        done_executed += exec.steps_executed;
+                        done_aborted += exec.steps_aborted;
+                        done_events.append(&mut exec.events);
+                        planning_time_s += m.plan.planning_time_s;
+                        steps_planned = done_executed + m.detailed.steps;
+                        if let Some(r) = &recorder {
+                            log_mission(r, &m)?;
+                        }
+                        exec = StepExecutor::new(
+                            &robot,
+                            config.clone(),
+                            m.detailed.keyframes,
+                            heights.clone(),
+                        );
+                        continue;
+                    }
+                    Err(e) => {
+                        failure = Some(format!("replan after \"{f}\" failed: {}", chain(&e)));
+                        break;
+                    }
+                }
+            }
+            ExecStatus::Running => {}
         }
-        // Leg heights from the height map, base pitched by 70 % of the slope (Sec. VI-B).
-        let posture = driving_posture(
-            &robot,
-            &truth,
-            params.driving_leg_height_m,
-            params.base_pitch_slope_fraction,
-            |x, y| heights.bilinear(x, y).or_else(|| heights.height_at_cell(x, y)),
-        )
-        .map_err(|[x, y]| RunJobError::UnknownGround { x, y })?;
-        let legs = leg_joint_targets(&robot, &posture)?;
-        let steer = Leg::ALL.map(|l| sim.steering_angle(l));
-        let commands = kin.commands(&robot, out.twist, &feet, &steer);
         for leg in Leg::ALL {
             let i = leg.index();
-            let c = kin.with_steering_rate(&robot, commands[i], sim.steering_rate(leg));
-            sim.set_leg_joint_targets(leg, legs[i]);
-            sim.set_steering_target(leg, c.steer);
-            sim.set_wheel_speeds(leg, c.wheel_speeds);
+            sim.set_leg_joint_targets(leg, cmd.legs[i]);
+            sim.set_steering_target(leg, cmd.wheels[i].steer);
+            sim.set_wheel_speeds(leg, cmd.wheels[i].wheel_speeds);
+        }
+        // The disturbance, if any.
+        if let Some(p) = &opts.push {
+            let now = sim.time();
+            let start = match p.when {
+                PushWhen::At(t) => Some(t),
+                PushWhen::Step { step, phase, delay_s } => {
+                    let in_phase = replans == 0
+                        && exec.active_step().is_some_and(|a| a.number == step)
+                        && exec.phase() == Some(phase);
+                    if in_phase && push_phase_start.is_none() {
+                        push_phase_start = Some(now);
+                    }
+                    push_phase_start.map(|t0| t0 + delay_s)
+                }
+            };
+            match (&mut push_report, start) {
+                (None, Some(t0)) if now >= t0 => {
+                    push_report = Some(PushReport {
+                        start_s: now,
+                        margin_before_m: last_margin,
+                        min_margin_after_m: last_margin,
+                        negative_margin_s: 0.0,
+                        max_tilt_deg: 0.0,
+                    });
+                    sim.push_base(p.force);
+                }
+                (Some(r), _) if now >= r.start_s + p.duration_s => sim.push_base([0.0; 3]),
+                _ => {}
+            }
         }
         sim.step(substeps)?;
         tick += 1;
-        let sample = StabilityMonitor::measure(&sim);
+        let sample = StabilityMonitor::measure(sim);
         if sim.time() >= SETTLE_S {
             monitor.record(&sample);
         }
-        max_track = max_track.max(out.cross_track_m.abs());
-        sum_track += out.cross_track_m.abs();
+        last_margin = sample.margin;
+        if let (Some(r), Some(p)) = (&mut push_report, &opts.push)
+            && sim.time() <= r.start_s + p.duration_s + 2.0
+        {
+            r.min_margin_after_m = r.min_margin_after_m.min(sample.margin);
+            if sample.margin < 0.0 {
+                r.negative_margin_s += control_dt;
+            }
+            let tilt = sample.roll_pitch[0].abs().max(sample.roll_pitch[1].abs());
+            r.max_tilt_deg = r.max_tilt_deg.max(tilt.to_degrees());
+        }
+        if let Some(a) = exec.active_step() {
+            let key = (replans, a.number);
+            if step_key != Some(key) {
+                step_key = Some(key);
+                step_margins.push(StepMargin {
+                    step: done_executed + done_aborted + a.number,
+                    leg: a.leg,
+                    min_margin_m: sample.margin,
+                });
+            }
+            if let Some(m) = step_margins.last_mut() {
+                m.min_margin_m = m.min_margin_m.min(sample.margin);
+            }
+        }
+        let commanded = exec.commanded_base();
+        let track = (commanded.x - truth.x).hypot(commanded.y - truth.y);
+        max_track = max_track.max(track);
+        sum_track += track;
         n_track += 1;
         max_pitch = max_pitch.max(sim.base().rpy[1].abs());
         if let Some(r) = &recorder
@@ -347,15 +639,19 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
                 heights.height_at_cell(sample.com[0], sample.com[1]).unwrap_or(0.0),
             )?;
             r.log_trajectory_point(sim.time(), sim.base().position)?;
-            r.log_scalar(sim.time(), "tracking_error_m", out.cross_track_m)?;
+            r.log_scalar(sim.time(), "tracking_error_m", track)?;
         }
         progress.set(sim.time());
     }
     progress.finish();
-    let exec_wall_s = exec_wall.elapsed().as_secs_f64();
+    let exec_wall_s = (exec_wall.elapsed().as_secs_f64() - replan_wall).max(1e-9);
     if let Some(r) = recorder.take() {
         r.finish()?;
     }
+    if !finished && failure.is_none() {
+        failure = Some(format!("time budget of {timeout} s used up"));
+    }
+    done_events.append(&mut exec.events);
     let base = sim.base();
     let goal = scenario.goal;
     let goal_position_error_m = (base.position[0] - goal.x).hypot(base.position[1] - goal.y);
@@ -371,17 +667,26 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
         goal_heading_error_rad,
         sim_time_s,
         wall_time_s: wall.elapsed().as_secs_f64(),
-        real_time_factor: sim_time_s / exec_wall_s.max(1e-9),
-        planning_time_s: plan.planning_time_s,
-        plan_cost: plan.cost,
-        plan_steps: plan.steps,
-        steps_executed: 0,
+        real_time_factor: sim_time_s / exec_wall_s,
+        planning_time_s,
+        plan_cost: first_plan.0,
+        plan_steps: first_plan.1,
+        steps_executed: done_executed + exec.steps_executed,
+        steps_planned,
+        steps_aborted: done_aborted + exec.steps_aborted,
+        replans,
+        keyframes: first_plan.2,
+        step_margins,
+        executor_events: done_events,
+        failure,
+        push: push_report,
         min_stability_margin_m: monitor.min_margin,
         tipped: monitor.tipped(),
         body_collisions: monitor.collided_bodies(),
         max_tracking_error_m: max_track,
         mean_tracking_error_m: if n_track > 0 { sum_track / n_track as f64 } else { 0.0 },
         max_pitch_deg: max_pitch.to_degrees(),
+        max_tilt_deg: monitor.max_tilt.to_degrees(),
         expectations: Vec::new(),
         events: monitor.events.clone(),
     };
