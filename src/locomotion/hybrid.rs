@@ -511,8 +511,11 @@ impl<'c> HybridGraph<'c> {
     fn standing_legs(&self, s: LatticeState, feet: &Feet) -> Option<[f64; 4]> {
         let pose = self.lattice.pose(s);
         let world = Self::feet_xyz(feet);
-        let (p, _) =
-            self.config.standing.stand(&self.robot, world, [pose.x, pose.y], pose.theta).ok()?;
+        let (p, _) = self
+            .config
+            .standing
+            .stand(&self.robot, self.maps.heights(), world, [pose.x, pose.y], pose.theta)
+            .ok()?;
         let hips = hips_in_world(&self.robot, &p);
         Some(std::array::from_fn(|k| hips[k][2] - world[k][2]))
     }
@@ -538,9 +541,18 @@ impl<'c> HybridGraph<'c> {
         let pre = Self::feet_xyz(feet);
         let rule = &self.config.standing;
         let swing = rule.swing_z(&self.robot, self.maps.heights(), pre[leg], post);
-        rule.step_heights(&self.robot, pre, leg, post, [pose.x, pose.y], pose.theta, swing)
-            .first()
-            .copied()
+        rule.step_heights(
+            &self.robot,
+            self.maps.heights(),
+            pre,
+            leg,
+            post,
+            [pose.x, pose.y],
+            pose.theta,
+            swing,
+        )
+        .first()
+        .copied()
     }
 
     /// Whether state `t` (footprint offsets `o`) may be entered; its body cost for
@@ -880,7 +892,10 @@ impl<'c> HybridGraph<'c> {
         let (hx, hy) = self.heading(s.theta);
         let d = f64::from(l) * self.lattice.resolution;
         let xy = [p.x + hx * d, p.y + hy * d];
-        self.config.standing.stand(&self.robot, Self::feet_xyz(feet), xy, p.theta).is_ok()
+        self.config
+            .standing
+            .stand(&self.robot, self.maps.heights(), Self::feet_xyz(feet), xy, p.theta)
+            .is_ok()
     }
 
     /// A base shift by `l` cells over the standing feet (see the module docs).

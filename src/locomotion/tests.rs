@@ -421,7 +421,7 @@ mod hybrid {
                 [base - 0.35, 0.32, 0.0],
                 [base - 0.35, -0.32, 0.0],
             ];
-            rule.stand(&robot, feet, [x, 0.0], 0.0).is_ok()
+            rule.stand(&robot, maps.heights(), feet, [x, 0.0], 0.0).is_ok()
         };
         assert!(stands(-l) && !stands(-l + 1), "shift of {} cells", -l);
         // C_B,avg = 1 + k3 · 0.2 = 1.1 (front feet 0.2 m higher; the legs are long

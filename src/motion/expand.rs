@@ -276,7 +276,7 @@ impl Expander<'_> {
     ) -> Result<Posture, String> {
         self.o
             .standing
-            .stand(self.robot, feet, xy, yaw)
+            .stand(self.robot, self.maps.heights(), feet, xy, yaw)
             .map(|(p, _)| p)
             .map_err(|e| format!("no standing leg height reaches every foot: {e}"))
     }
@@ -321,6 +321,11 @@ impl Expander<'_> {
                 }
             }
             let e = evaluate(self.robot, self.model, &p, o.standing.reach_margin_m)
+                .and_then(|e| {
+                    o.standing
+                        .legs_clear(self.robot, self.maps.heights(), &p, &e.joints)
+                        .map(|()| e)
+                })
                 .map_err(|e| format!("at {:.0} % of the segment: {e}", t * 100.0))?;
             if e.margin < o.min_margin_m {
                 return Err(format!(
@@ -584,7 +589,8 @@ impl Expander<'_> {
         let (pre, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
         let rule = self.o.standing;
         let swing_z = rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
-        let mut heights = rule.step_heights(self.robot, pre, i, post_foot, xy, yaw, swing_z);
+        let mut heights =
+            rule.step_heights(self.robot, self.maps.heights(), pre, i, post_foot, xy, yaw, swing_z);
         heights.extend([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1]);
         // First the paper's sequence (a base shift only where the wheel was hindered), in
         // full, half or none of each alignment; then base shifts of fixed length with

@@ -71,6 +71,14 @@ pub enum PostureError {
         /// Required spare reach, m.
         margin: f64,
     },
+    /// A thigh or shin would touch the terrain.
+    #[error("leg {leg:?}: thigh or shin {clearance:.3} m above the terrain")]
+    LegCollision {
+        /// The leg.
+        leg: Leg,
+        /// Clearance of its lowest point, m.
+        clearance: f64,
+    },
     /// The standing rule has no leg height to try.
     #[error("no leg height to try")]
     NoHeight,

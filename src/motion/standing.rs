@@ -39,6 +39,11 @@ pub struct StandingRule {
     pub reach_margin_m: f64,
     /// Swing foot clearance above the terrain near its path, m.
     pub swing_clearance_m: f64,
+    /// Smallest height of a thigh or shin axis point above the terrain within
+    /// `leg_clearance_radius_m` of it, m: the capsule radius (2.5 cm) and 1.5 cm to spare.
+    pub leg_clearance_m: f64,
+    /// Horizontal radius around a leg point inside which terrain counts, m.
+    pub leg_clearance_radius_m: f64,
 }
 
 impl StandingRule {
@@ -52,6 +57,8 @@ impl StandingRule {
             pitch_fraction: params.base_pitch_slope_fraction,
             reach_margin_m: 0.002,
             swing_clearance_m: 0.05,
+            leg_clearance_m: 0.04,
+            leg_clearance_radius_m: 0.04,
         }
     }
 
@@ -76,6 +83,52 @@ impl StandingRule {
         (0..=n).map(move |k| top - k as f64 * step)
     }
 
+    /// Whether every thigh and shin of posture `p` (joint angles `joints`) keeps
+    /// `leg_clearance_m` above the highest terrain within `leg_clearance_radius_m` of
+    /// points every 5 cm along it: a lowered base must not fold a knee onto a step.
+    ///
+    /// # Errors
+    /// [`PostureError::LegCollision`] naming the leg and its clearance.
+    pub fn legs_clear(
+        &self,
+        robot: &RobotDescription,
+        terrain: &HeightMap,
+        p: &Posture,
+        joints: &[[f64; 3]; 4],
+    ) -> Result<(), PostureError> {
+        let r = rotation(p.base_rpy);
+        for leg in crate::robot::Leg::ALL {
+            let i = leg.index();
+            let (h, q) = (robot.hips[i], joints[i]);
+            let knee =
+                [h[0] - robot.thigh_length * q[0].sin(), h[2] - robot.thigh_length * q[0].cos()];
+            let a = q[0] + q[1];
+            let ankle =
+                [knee[0] - robot.shin_length * a.sin(), knee[1] - robot.shin_length * a.cos()];
+            let chain = [[h[0], h[2]], knee, ankle];
+            for seg in chain.windows(2) {
+                for k in 0..=5 {
+                    let t = f64::from(k) / 5.0;
+                    let b = [
+                        seg[0][0] + (seg[1][0] - seg[0][0]) * t,
+                        h[1],
+                        seg[0][1] + (seg[1][1] - seg[0][1]) * t,
+                    ];
+                    let w = apply(&r, p.base_position, b);
+                    let top = terrain.max_height_near_segment(
+                        [w[0], w[1], f64::NEG_INFINITY],
+                        [w[0], w[1], f64::NEG_INFINITY],
+                        self.leg_clearance_radius_m,
+                    );
+                    if top.is_finite() && w[2] - top < self.leg_clearance_m {
+                        return Err(PostureError::LegCollision { leg, clearance: w[2] - top });
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Pitch for feet `feet` under heading `yaw`.
     pub fn pitch(&self, feet: &[[f64; 3]; 4], yaw: f64) -> f64 {
         pitch_from_feet(feet, yaw, self.pitch_fraction)
@@ -87,13 +140,15 @@ impl StandingRule {
     }
 
     /// The first height of [`Self::heights`] at which all four feet (in contact, on their
-    /// legs' planes) are reached, with the posture.
+    /// legs' planes) are reached and no thigh or shin touches `terrain`
+    /// ([`Self::legs_clear`]), with the posture.
     ///
     /// # Errors
     /// The last height's [`PostureError`] if none reaches.
     pub fn stand(
         &self,
         robot: &RobotDescription,
+        terrain: &HeightMap,
         feet: [[f64; 3]; 4],
         xy: [f64; 2],
         yaw: f64,
@@ -108,8 +163,10 @@ impl StandingRule {
                 continue;
             }
             let p = level_posture(robot, feet, [true; 4], xy, [0.0, pitch, yaw], h, ground);
-            match solve_legs(robot, &p, self.reach_margin_m) {
-                Ok(_) => return Ok((p, h)),
+            match solve_legs(robot, &p, self.reach_margin_m)
+                .and_then(|q| self.legs_clear(robot, terrain, &p, &q))
+            {
+                Ok(()) => return Ok((p, h)),
                 Err(e) => last = Some(e),
             }
         }
@@ -125,6 +182,7 @@ impl StandingRule {
     pub fn step_heights(
         &self,
         robot: &RobotDescription,
+        terrain: &HeightMap,
         pre: [[f64; 3]; 4],
         leg: usize,
         post_foot: [f64; 3],
@@ -160,7 +218,9 @@ impl StandingRule {
                 probes.iter().all(|p| p.distances_ok(h).is_ok())
                     && variants.iter().all(|feet| {
                         let p = level_posture(robot, *feet, [true; 4], xy, rpy, h, ground);
-                        solve_legs(robot, &p, self.reach_margin_m).is_ok()
+                        solve_legs(robot, &p, self.reach_margin_m)
+                            .and_then(|q| self.legs_clear(robot, terrain, &p, &q))
+                            .is_ok()
                     })
             })
             .collect()
@@ -347,6 +407,14 @@ mod tests {
         StandingRule::from_params(&Params::default())
     }
 
+    /// A 0.2 m platform from x = 0.2 m on, 2.5 cm cells over [−2, 2]².
+    fn platform() -> HeightMap {
+        HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |i, _| {
+            if -2.0 + (i as f64 + 0.5) * 0.025 >= 0.2 { 0.2 } else { 0.0 }
+        })
+        .unwrap()
+    }
+
     #[test]
     fn heights_run_from_the_soft_constraint_to_driving_height() {
         let h: Vec<f64> = rule().heights().collect();
@@ -375,7 +443,7 @@ mod tests {
         // (about 0.57 m) cannot reach 0.36 m back; a lower height can.
         let robot = RobotDescription::reference();
         let feet = [[0.35, 0.32, 0.2], [0.35, -0.32, 0.2], [-0.71, 0.32, 0.0], [-0.71, -0.32, 0.0]];
-        let (p, h) = rule().stand(&robot, feet, [0.0, 0.0], 0.0).unwrap();
+        let (p, h) = rule().stand(&robot, &platform(), feet, [0.0, 0.0], 0.0).unwrap();
         assert!(h < 0.45 - 1e-9, "height {h}");
         assert!(solve_legs(&robot, &p, 0.002).is_ok());
         // The leg height one step above fails.
@@ -391,7 +459,7 @@ mod tests {
         assert!(solve_legs(&robot, &above, 0.002).is_err());
         // Far out of reach: a clear error.
         let far = [[0.35, 0.32, 0.0], [0.35, -0.32, 0.0], [-1.2, 0.32, 0.0], [-0.35, -0.32, 0.0]];
-        assert!(rule().stand(&robot, far, [0.0, 0.0], 0.0).is_err());
+        assert!(rule().stand(&robot, &platform(), far, [0.0, 0.0], 0.0).is_err());
     }
 
     #[test]
@@ -401,7 +469,8 @@ mod tests {
         // Front feet on a 0.2 m platform, rear feet under their hips on the floor; the
         // rear-left foot steps 0.3 m forward onto the platform.
         let pre = [[0.35, 0.32, 0.2], [0.35, -0.32, 0.2], [-0.35, 0.32, 0.0], [-0.35, -0.32, 0.0]];
-        let hs = r.step_heights(&robot, pre, 2, [-0.05, 0.32, 0.2], [0.0, 0.0], 0.0, 0.25);
+        let hs =
+            r.step_heights(&robot, &platform(), pre, 2, [-0.05, 0.32, 0.2], [0.0, 0.0], 0.0, 0.25);
         assert!(!hs.is_empty());
         // Every height listed really reaches with the stepping leg over 0.2 m…
         let mut post = pre;
@@ -422,7 +491,16 @@ mod tests {
         // …and with the other rear foot 0.4 m behind its hip no height does.
         let mut stretched = pre;
         stretched[3][0] = -0.75;
-        let hs = r.step_heights(&robot, stretched, 2, [-0.05, 0.32, 0.2], [0.0, 0.0], 0.0, 0.25);
+        let hs = r.step_heights(
+            &robot,
+            &platform(),
+            stretched,
+            2,
+            [-0.05, 0.32, 0.2],
+            [0.0, 0.0],
+            0.0,
+            0.25,
+        );
         assert!(hs.is_empty(), "{hs:?}");
     }
 
@@ -483,5 +561,33 @@ mod tests {
         // Out of reach: an error, not a guess.
         q.feet[2][0] -= 1.0;
         assert!(com_estimate(&robot, &q).is_err());
+    }
+
+    #[test]
+    fn a_knee_in_the_platform_is_a_collision() {
+        // Rear legs on the floor with the platform edge 0.1 m ahead of the rear hips: the
+        // rear knees point forward, over the platform. Standing tall they clear it; with
+        // the base low (hips 0.27 m up) the knees dip below 0.2 + 0.04 m.
+        let robot = RobotDescription::reference();
+        let r = rule();
+        let hm = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |i, _| {
+            if -2.0 + (i as f64 + 0.5) * 0.025 >= -0.25 { 0.2 } else { 0.0 }
+        })
+        .unwrap();
+        let feet = [[0.35, 0.32, 0.2], [0.35, -0.32, 0.2], [-0.35, 0.32, 0.0], [-0.35, -0.32, 0.0]];
+        let ground = feet.map(|f| f[2]);
+        let pose =
+            |h: f64| level_posture(&robot, feet, [true; 4], [0.0, 0.0], [0.0, 0.0, 0.0], h, ground);
+        let low = pose(0.27);
+        let q = solve_legs(&robot, &low, 0.0).unwrap();
+        match r.legs_clear(&robot, &hm, &low, &q) {
+            Err(PostureError::LegCollision { leg, clearance }) => {
+                assert!(!leg.is_front() && clearance < 0.04, "{leg:?} {clearance}");
+            }
+            other => panic!("expected a collision, got {other:?}"),
+        }
+        let tall = pose(0.45);
+        let q = solve_legs(&robot, &tall, 0.0).unwrap();
+        assert!(r.legs_clear(&robot, &hm, &tall, &q).is_ok());
     }
 }
