@@ -158,6 +158,10 @@ pub struct PlannerArgs {
     /// ARA*'s initial heuristic weight (default: the scenario's, 3.0).
     #[arg(long, allow_negative_numbers = true)]
     pub initial_epsilon: Option<f64>,
+    /// ARA* stops at a solution with this ε (default 1, the optimum); set it to the
+    /// initial ε to take the first solution, the same on any machine.
+    #[arg(long, allow_negative_numbers = true)]
+    pub final_epsilon: Option<f64>,
     /// Orientation cost factor k12 (default: the scenario's, 2.0).
     #[arg(long, allow_negative_numbers = true)]
     pub k12: Option<f64>,
@@ -172,6 +176,7 @@ impl PlannerArgs {
             },
             time_limit_s: self.time_limit,
             initial_epsilon: self.initial_epsilon,
+            final_epsilon: self.final_epsilon,
             k12: self.k12,
             ..jobs::plan::PlanOptions::default()
         }

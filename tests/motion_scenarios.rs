@@ -27,7 +27,8 @@ fn sim() -> Simulation {
 fn planned(s: &Scenario, sim: &Simulation) -> PlanSummary {
     let opts = PlanOptions {
         algorithm: Algorithm::AraStar,
-        time_limit_s: 200.0,
+        time_limit_s: 600.0,
+        final_epsilon: Some(3.0),
         ..PlanOptions::default()
     };
     plan::run(s, sim.robot(), &opts).expect("plan")

@@ -19,7 +19,8 @@ use momaro::sim::Simulation;
 use std::time::Instant;
 
 fn plan_options() -> PlanOptions {
-    PlanOptions { time_limit_s: 60.0, ..PlanOptions::default() }
+    // ARA*'s first solution: the same plan on any machine.
+    PlanOptions { time_limit_s: 600.0, final_epsilon: Some(3.0), ..PlanOptions::default() }
 }
 
 /// Where an executed prefix of a plan ends.

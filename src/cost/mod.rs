@@ -85,6 +85,10 @@ pub enum CostError {
     },
 }
 
+/// Cells by which [`CostMaps::leg_terrain`] dilates the heights: 2 (5 cm at 2.5 cm cells,
+/// the leg capsule's 2.5 cm radius and the half cell a point may sit off its cell centre).
+pub const LEG_TERRAIN_CELLS: usize = 2;
+
 /// Height map, precomputed cost layers, weights and robot geometry: everything needed to
 /// answer cost queries for any pose on one map.
 #[derive(Debug, Clone)]
@@ -95,6 +99,8 @@ pub struct CostMaps {
     /// look-ups share one cache line, which matters for scattered queries.
     foot_cells: Vec<[f64; 2]>,
     disc_max: DiscMaxLayer,
+    /// Heights dilated by two cells (5 cm): the terrain a leg point must clear.
+    leg_terrain: HeightMap,
     body: BodyGeometry,
     weights: PoseWeights,
     neutral_footprint: [[f64; 2]; 4],
@@ -141,6 +147,7 @@ impl CostMaps {
             foot,
             foot_cells,
             disc_max: DiscMaxLayer::compute(map, params.base_circle_radius_m),
+            leg_terrain: map.dilated_max(LEG_TERRAIN_CELLS),
             body,
             weights: PoseWeights { k4: params.k4, k5: params.k5, k6: params.k6 },
             neutral_footprint: robot.neutral_footprint(),
@@ -152,6 +159,12 @@ impl CostMaps {
     /// The height map the costs were computed from.
     pub fn heights(&self) -> &HeightMap {
         &self.heights
+    }
+
+    /// The heights dilated by [`LEG_TERRAIN_CELLS`] cells: per cell the highest terrain a
+    /// leg segment (capsule radius 2.5 cm) over it could touch (`motion::standing`).
+    pub fn leg_terrain(&self) -> &HeightMap {
+        &self.leg_terrain
     }
 
     /// The foot-cost layer.

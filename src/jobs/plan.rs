@@ -46,6 +46,10 @@ pub struct PlanOptions {
     pub time_limit_s: f64,
     /// ARA*'s initial heuristic weight; default `Params::arastar_initial_epsilon` (3.0).
     pub initial_epsilon: Option<f64>,
+    /// ARA* stops once a solution with this ε is found (default 1: the optimum). Equal
+    /// to the initial ε, the first solution is taken: the same plan on any machine, where
+    /// a time limit cuts the anytime search wherever the CPU happens to be.
+    pub final_epsilon: Option<f64>,
     /// Orientation cost factor k12 (Sec. VII-A); default the scenario's (2.0).
     pub k12: Option<f64>,
     /// Step-related cost factor; default the scenario's (`Params::step_cost_factor`).
@@ -60,6 +64,7 @@ impl Default for PlanOptions {
             algorithm: Algorithm::AraStar,
             time_limit_s: 10.0,
             initial_epsilon: None,
+            final_epsilon: None,
             k12: None,
             step_cost_factor: None,
             neighbourhood: None,
@@ -499,6 +504,14 @@ pub fn run(
     {
         return Err(bad("k12", format!("{k} must be at least 1")));
     }
+    if let Some(e) = opts.final_epsilon
+        && !(e.is_finite() && e >= 1.0 && e <= opts.initial_epsilon.unwrap_or(e))
+    {
+        return Err(bad(
+            "final_epsilon",
+            format!("{e} must be at least 1 and at most the initial ε"),
+        ));
+    }
     let t0 = Instant::now();
     let file = || scenario.path.clone();
     let prep = prepare(scenario, robot, opts.k12, opts.step_cost_factor)?;
@@ -508,6 +521,7 @@ pub fn run(
     let eps0 = opts.initial_epsilon.unwrap_or(prep.params.arastar_initial_epsilon);
     let search_params = SearchParams {
         initial_epsilon: eps0,
+        final_epsilon: opts.final_epsilon.unwrap_or(1.0).min(eps0),
         epsilon_decay: prep.params.arastar_epsilon_decay,
         time_limit: Some(limit.saturating_sub(t0.elapsed())),
         ..SearchParams::default()

@@ -514,7 +514,7 @@ impl<'c> HybridGraph<'c> {
         let (p, _) = self
             .config
             .standing
-            .stand(&self.robot, self.maps.heights(), world, [pose.x, pose.y], pose.theta)
+            .stand(&self.robot, self.maps.leg_terrain(), world, [pose.x, pose.y], pose.theta)
             .ok()?;
         let hips = hips_in_world(&self.robot, &p);
         Some(std::array::from_fn(|k| hips[k][2] - world[k][2]))
@@ -543,7 +543,7 @@ impl<'c> HybridGraph<'c> {
         let swing = rule.swing_z(&self.robot, self.maps.heights(), pre[leg], post);
         rule.step_heights(
             &self.robot,
-            self.maps.heights(),
+            self.maps.leg_terrain(),
             pre,
             leg,
             post,
@@ -723,9 +723,12 @@ impl<'c> HybridGraph<'c> {
         // Longitudinal base shift: both front feet ahead of neutral; forward until a
         // front foot is neutral or a rear leg is at the end of its reach.
         if o[0] > 0 && o[1] > 0 {
-            let mut l = o[0].min(o[1]);
-            while l > 0 && !self.shift_in_reach(s, &feet, l) {
-                l -= 1;
+            // Every cell of the way must stand by the rule (the generator moves the base
+            // through them), so the shift ends before the first that cannot.
+            let max = o[0].min(o[1]);
+            let mut l = 0;
+            while l < max && self.shift_in_reach(s, &feet, l + 1) {
+                l += 1;
             }
             if l > 0 {
                 self.push_base_shift(s, &o, &feet, l);
@@ -894,7 +897,7 @@ impl<'c> HybridGraph<'c> {
         let xy = [p.x + hx * d, p.y + hy * d];
         self.config
             .standing
-            .stand(&self.robot, self.maps.heights(), Self::feet_xyz(feet), xy, p.theta)
+            .stand(&self.robot, self.maps.leg_terrain(), Self::feet_xyz(feet), xy, p.theta)
             .is_ok()
     }
 

@@ -276,7 +276,7 @@ impl Expander<'_> {
     ) -> Result<Posture, String> {
         self.o
             .standing
-            .stand(self.robot, self.maps.heights(), feet, xy, yaw)
+            .stand(self.robot, self.maps.leg_terrain(), feet, xy, yaw)
             .map(|(p, _)| p)
             .map_err(|e| format!("no standing leg height reaches every foot: {e}"))
     }
@@ -323,7 +323,7 @@ impl Expander<'_> {
             let e = evaluate(self.robot, self.model, &p, o.standing.reach_margin_m)
                 .and_then(|e| {
                     o.standing
-                        .legs_clear(self.robot, self.maps.heights(), &p, &e.joints)
+                        .legs_clear(self.robot, self.maps.leg_terrain(), &p, &e.joints)
                         .map(|()| e)
                 })
                 .map_err(|e| format!("at {:.0} % of the segment: {e}", t * 100.0))?;
@@ -589,8 +589,16 @@ impl Expander<'_> {
         let (pre, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
         let rule = self.o.standing;
         let swing_z = rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
-        let mut heights =
-            rule.step_heights(self.robot, self.maps.heights(), pre, i, post_foot, xy, yaw, swing_z);
+        let mut heights = rule.step_heights(
+            self.robot,
+            self.maps.leg_terrain(),
+            pre,
+            i,
+            post_foot,
+            xy,
+            yaw,
+            swing_z,
+        );
         heights.extend([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1]);
         // First the paper's sequence (a base shift only where the wheel was hindered), in
         // full, half or none of each alignment; then base shifts of fixed length with
@@ -793,10 +801,21 @@ pub fn expand_path(
                         for (f, p) in feet.iter_mut().zip(el.feet) {
                             *f = [p[0], p[1], ex.ground(p[0], p[1])?];
                         }
-                        let p = ex
-                            .standing_fallback(feet, [el.pose.x, el.pose.y], el.pose.theta)
-                            .map_err(bad)?;
-                        ex.push(el.kind, &[(Phase::PlannedBaseShift, None, p)])?;
+                        // Through every cell of the way by the standing rule, as the
+                        // planner checked it (legs reach and clear the terrain).
+                        let (from, to) = (ex.xy(), [el.pose.x, el.pose.y]);
+                        let res = maps.heights().resolution();
+                        let dist = (to[0] - from[0]).hypot(to[1] - from[1]);
+                        let n = (dist / res).ceil().max(1.0) as usize;
+                        let mut seq = Vec::with_capacity(n);
+                        for k in 1..=n {
+                            let t = k as f64 / n as f64;
+                            let xy =
+                                [from[0] + (to[0] - from[0]) * t, from[1] + (to[1] - from[1]) * t];
+                            let p = ex.standing_fallback(feet, xy, el.pose.theta).map_err(bad)?;
+                            seq.push((Phase::PlannedBaseShift, None, p));
+                        }
+                        ex.push(el.kind, &seq)?;
                     }
                     (_, Some(leg)) => {
                         let mut feet = ex.cur.feet;

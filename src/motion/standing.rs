@@ -39,11 +39,10 @@ pub struct StandingRule {
     pub reach_margin_m: f64,
     /// Swing foot clearance above the terrain near its path, m.
     pub swing_clearance_m: f64,
-    /// Smallest height of a thigh or shin axis point above the terrain within
-    /// `leg_clearance_radius_m` of it, m: the capsule radius (2.5 cm) and 1.5 cm to spare.
+    /// Smallest height of a thigh or shin axis point above the terrain under it (the
+    /// dilated `CostMaps::leg_terrain`), m: the capsule radius (2.5 cm) and 1.5 cm to
+    /// spare.
     pub leg_clearance_m: f64,
-    /// Horizontal radius around a leg point inside which terrain counts, m.
-    pub leg_clearance_radius_m: f64,
 }
 
 impl StandingRule {
@@ -58,7 +57,6 @@ impl StandingRule {
             reach_margin_m: 0.002,
             swing_clearance_m: 0.05,
             leg_clearance_m: 0.04,
-            leg_clearance_radius_m: 0.04,
         }
     }
 
@@ -84,8 +82,9 @@ impl StandingRule {
     }
 
     /// Whether every thigh and shin of posture `p` (joint angles `joints`) keeps
-    /// `leg_clearance_m` above the highest terrain within `leg_clearance_radius_m` of
-    /// points every 5 cm along it: a lowered base must not fold a knee onto a step.
+    /// `leg_clearance_m` above `terrain` (heights dilated by the legs' width, see
+    /// `CostMaps::leg_terrain`) at points a quarter segment (6.25 cm) apart along it: a lowered base must not fold a
+    /// knee onto a step.
     ///
     /// # Errors
     /// [`PostureError::LegCollision`] naming the leg and its clearance.
@@ -107,20 +106,17 @@ impl StandingRule {
                 [knee[0] - robot.shin_length * a.sin(), knee[1] - robot.shin_length * a.cos()];
             let chain = [[h[0], h[2]], knee, ankle];
             for seg in chain.windows(2) {
-                for k in 0..=5 {
-                    let t = f64::from(k) / 5.0;
+                // A quarter segment apart, far end included (the hip never dips).
+                for k in 1..=4 {
+                    let t = f64::from(k) / 4.0;
                     let b = [
                         seg[0][0] + (seg[1][0] - seg[0][0]) * t,
                         h[1],
                         seg[0][1] + (seg[1][1] - seg[0][1]) * t,
                     ];
                     let w = apply(&r, p.base_position, b);
-                    let top = terrain.max_height_near_segment(
-                        [w[0], w[1], f64::NEG_INFINITY],
-                        [w[0], w[1], f64::NEG_INFINITY],
-                        self.leg_clearance_radius_m,
-                    );
-                    if top.is_finite() && w[2] - top < self.leg_clearance_m {
+                    let Some(top) = terrain.height_at_cell(w[0], w[1]) else { continue };
+                    if w[2] - top < self.leg_clearance_m {
                         return Err(PostureError::LegCollision { leg, clearance: w[2] - top });
                     }
                 }
@@ -580,6 +576,7 @@ mod tests {
             |h: f64| level_posture(&robot, feet, [true; 4], [0.0, 0.0], [0.0, 0.0, 0.0], h, ground);
         let low = pose(0.27);
         let q = solve_legs(&robot, &low, 0.0).unwrap();
+        let hm = hm.dilated_max(crate::cost::LEG_TERRAIN_CELLS);
         match r.legs_clear(&robot, &hm, &low, &q) {
             Err(PostureError::LegCollision { leg, clearance }) => {
                 assert!(!leg.is_front() && clearance < 0.04, "{leg:?} {clearance}");

@@ -304,6 +304,36 @@ impl HeightMap {
         self.get(i, j)
     }
 
+    /// The map whose cell (i, j) holds the highest known height of the (2r + 1)² cells
+    /// around (i, j) here (NaN where none is known): what a body part of up to r cells'
+    /// reach over a cell must clear, answered by one look-up.
+    pub fn dilated_max(&self, r: usize) -> HeightMap {
+        let mut out = self.clone();
+        for j in 0..self.ny {
+            for i in 0..self.nx {
+                let [x, y] = self.cell_center(i, j);
+                out.data[j * self.nx + i] = self.max_around(x, y, r).unwrap_or(f64::NAN);
+            }
+        }
+        out
+    }
+
+    /// Highest known height over the (2r + 1)² cells around the cell containing (x, y),
+    /// `None` if none is known (or the point is off the map).
+    #[inline]
+    pub fn max_around(&self, x: f64, y: f64, r: usize) -> Option<f64> {
+        let (i, j) = self.cell_of(x, y)?;
+        let mut best: Option<f64> = None;
+        for jj in j.saturating_sub(r)..=(j + r).min(self.ny - 1) {
+            for ii in i.saturating_sub(r)..=(i + r).min(self.nx - 1) {
+                if let Some(h) = self.get(ii, jj) {
+                    best = Some(best.map_or(h, |b: f64| b.max(h)));
+                }
+            }
+        }
+        best
+    }
+
     /// Highest known terrain over the cells whose centres lie within `radius` of the
     /// segment from `a` to `b` (x, y; the ends' z count too), m: what a foot carried along
     /// the segment must clear.
@@ -458,6 +488,27 @@ impl<'a> HeightMapView<'a> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn max_around_a_cell_by_hand() {
+        let hm = HeightMap::from_fn([0.0, 0.0], 0.1, 4, 4, |i, j| (i + 10 * j) as f64).unwrap();
+        // Around cell (1, 1): cells 0..=2 in both directions, highest (2, 2) = 22.
+        assert_eq!(hm.max_around(0.15, 0.15, 1), Some(22.0));
+        // At the corner the block is clipped to the map.
+        assert_eq!(hm.max_around(0.05, 0.05, 1), Some(11.0));
+        assert_eq!(hm.max_around(0.35, 0.35, 0), Some(33.0));
+        assert_eq!(hm.max_around(-1.0, 0.0, 1), None);
+    }
+
+    #[test]
+    fn dilated_max_by_hand() {
+        let hm = HeightMap::from_fn([0.0, 0.0], 0.1, 4, 4, |i, j| (i + 10 * j) as f64).unwrap();
+        let d = hm.dilated_max(1);
+        assert_eq!(d.get(0, 0), Some(11.0));
+        assert_eq!(d.get(1, 2), Some(32.0));
+        assert_eq!(d.get(3, 3), Some(33.0));
+        assert_eq!(hm.dilated_max(0), hm);
+    }
 
     #[test]
     fn max_height_near_a_segment_by_hand() {
