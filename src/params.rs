@@ -102,9 +102,11 @@ pub struct Params {
     /// Planner's support check for a step: the signed distance of a CoM estimate to the
     /// support triangle of the other three feet (the partner wheel moved toward the
     /// centre as the generator would) must be at least this, m. Base roll (eqs. 6–8) and a
-    /// base shift take the CoM the rest of the way. Ours: 0.04 m, the generator's 3 cm
-    /// plus 1 cm for the stepping leg folding as its foot lifts (the paper leaves
-    /// stability to the generator, whose failures it does not report).
+    /// base shift take the CoM the rest of the way. Ours: 0.055 m, the generator's 3 cm
+    /// plus 2.5 cm for what the estimate leaves out (the stepping leg folding as its foot
+    /// lifts, the stance legs' compliance); at 0.04 m a staircase rear step passed the
+    /// check and failed the generator by 3 mm. The paper leaves stability to the
+    /// generator, whose failures it does not report.
     pub step_support_margin_m: f64,
 
     /// ARA*: initial heuristic weight (Sec. VIII): 3.0.
@@ -146,7 +148,7 @@ impl Default for Params {
             min_lift_margin_m: 0.02,
             max_wheel_to_centre_m: 0.45,
             wheel_gap_m: 0.3,
-            step_support_margin_m: 0.04,
+            step_support_margin_m: 0.055,
             arastar_initial_epsilon: 3.0,
             arastar_epsilon_decay: 0.5,
         }

@@ -518,9 +518,21 @@ impl Expander<'_> {
             }
             let sol = roll_for_lateral_com([y_rot, z_rot], [lateral(com), com[2]], y_target, b)
                 .map_err(|e| e.to_string())?;
-            roll = (roll + sol.roll).clamp(-o.max_roll_rad, o.max_roll_rad);
-            let p = self.standing(moved, all, xy, yaw, pitch, roll, height, ground);
-            com = self.com_of(&p)?;
+            // A roll that takes a stretched leg out of reach is halved (up to three
+            // times) rather than dropping the candidate: part of the alignment still helps.
+            let mut step = sol.roll;
+            let mut next = None;
+            for _ in 0..4 {
+                let r = (roll + step).clamp(-o.max_roll_rad, o.max_roll_rad);
+                let p = self.standing(moved, all, xy, yaw, pitch, r, height, ground);
+                if let Ok(c) = self.com_of(&p) {
+                    next = Some((r, c));
+                    break;
+                }
+                step /= 2.0;
+            }
+            let Some((r, c)) = next else { break };
+            (roll, com) = (r, c);
         }
 
         // Longitudinal remainder: base shift (Fig. 12b).
