@@ -150,23 +150,92 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
     report(&s, p.path.len(), p.path.len(), &d);
     check(&d, &sim);
     check_steps(&p, &d);
-    // All four feet end on the platform; a stabilising base shift (Fig. 12b) is used and
-    // reversed.
+    // All four feet end on the platform. (The stabilising base shift of Fig. 12b is
+    // tested where a wheel is blocked: `a_blocked_wheel_leaves_the_alignment_to_a_base_shift`.)
     assert!(d.keyframes.last().is_some_and(|k| k.feet.iter().all(|f| f[2] > 0.15)));
-    let ph = phases(&d);
-    assert!(ph.contains(&Phase::BaseShift) && ph.contains(&Phase::ShiftBack));
 
-    // The same path with an unreachable margin fails at its first step, naming it.
+    // The path up to its first step, with a margin no step can keep, fails at that step,
+    // naming it and its leg.
     let robot = sim.robot().clone();
     let prep = plan::prepare(&s, &robot, None, None).expect("maps");
-    let options = MotionOptions { min_margin_m: 0.5, ..MotionOptions::from_params(&prep.params) };
+    // 15 cm: the four-wheel postures before it keep more (about 0.3 m), no three-wheel
+    // posture can (its best: 0.1 m).
+    let options = MotionOptions { min_margin_m: 0.15, ..MotionOptions::from_params(&prep.params) };
     let first = p.path.iter().position(|e| e.kind == PathKind::Step).expect("a step");
-    match expand_path(&p.path, &robot, &prep.maps, &mut sim, &options) {
+    match expand_path(&p.path[..=first], &robot, &prep.maps, &mut sim, &options) {
         Err(MotionError::Step { index, leg, best_margin_m, required_m, .. }) => {
             assert_eq!(index, first);
             assert_eq!(Some(leg), p.path[first].leg);
-            assert!(best_margin_m < required_m && required_m == 0.5);
+            assert!(best_margin_m < required_m && required_m == 0.15);
         }
         other => panic!("expected a step failure, got {other:?}"),
     }
+}
+
+#[test]
+fn a_blocked_wheel_leaves_the_alignment_to_a_base_shift() {
+    // Flat ground. The front-left foot steps 0.3 m over a low bar (0.1 m); a block just
+    // ahead of the rear-left wheel keeps that wheel from driving toward the centre
+    // (Fig. 12a), so the generator aligns the CoM with the support triangle by shifting
+    // the base instead (Fig. 12b), and shifts it back after the step.
+    let text = r#"
+name = "blocked_wheel"
+[map]
+x_min = -1.5
+x_max = 2.0
+y_min = -1.2
+y_max = 1.2
+[start]
+x = -0.8
+y = -0.6
+[goal]
+x = 1.2
+y = -0.6
+[[terrain]]
+kind = "box"
+center = [0.52, 0.35]
+size = [0.06, 0.5]
+height = 0.1
+[[terrain]]
+kind = "box"
+center = [-0.2, 0.32]
+size = [0.05, 0.3]
+height = 0.1
+"#;
+    // (The scenario's start and goal lie elsewhere: the path below starts next to the block.)
+    let s = Scenario::parse(text, Path::new("blocked_wheel.toml")).expect("scenario");
+    let mut sim = sim();
+    let robot = sim.robot().clone();
+    let prep = plan::prepare(&s, &robot, None, None).expect("maps");
+    let neutral = robot.neutral_footprint();
+    let start = PathElement {
+        kind: PathKind::Start,
+        leg: None,
+        pose: momaro::geometry::Pose2::new(0.0, 0.0, 0.0),
+        feet: neutral,
+        foot_heights: [Some(0.0); 4],
+        foot_offsets_m: [0.0; 4],
+        cost: 0.0,
+        step: None,
+    };
+    let mut feet = neutral;
+    feet[0][0] += 0.3;
+    let step = PathElement {
+        kind: PathKind::Step,
+        leg: Some(Leg::FrontLeft),
+        feet,
+        foot_offsets_m: [0.3, 0.0, 0.0, 0.0],
+        ..start.clone()
+    };
+    let options = MotionOptions::from_params(&prep.params);
+    let d = expand_path(&[start, step], &robot, &prep.maps, &mut sim, &options).expect("expands");
+    check(&d, &sim);
+    let ph = phases(&d);
+    assert!(!ph.contains(&Phase::WheelToCentre), "{ph:?}");
+    let shift = d.keyframes.iter().find(|k| k.phase == Phase::BaseShift).expect("a base shift");
+    // Backward, toward the triangle of the other three feet (centroid at x = −0.117 m).
+    assert!(shift.base_position[0] < -0.02, "{:?}", shift.base_position);
+    let back = d.keyframes.iter().find(|k| k.phase == Phase::ShiftBack).expect("shifted back");
+    assert!(back.base_position[0].abs() < 1e-9, "{:?}", back.base_position);
+    assert!(d.keyframes.iter().any(|k| k.phase == Phase::Place && k.leg == Some(Leg::FrontLeft)));
 }

@@ -882,8 +882,7 @@ impl<'c> HybridGraph<'c> {
             .map(|k| if k == partner { moved } else { feet.pos[k] })
             .collect();
         let pre = Self::feet_xyz(feet);
-        let stance =
-            c.standing.step_posture(&self.robot, pre, leg, post, [p.x, p.y], p.theta, height);
+        let stance = c.standing.step_posture(&self.robot, pre, leg, post, &p, height);
         com_estimate(&self.robot, &stance)
             .is_ok_and(|com| stability_margin(&support, com) >= c.step_support_margin_m)
     }

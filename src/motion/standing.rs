@@ -20,6 +20,7 @@
 //!   clear it), and its foot must also be reachable at the swing height above both ends.
 
 use super::kinematics::{Posture, PostureError, apply, pitch_from_feet, rotation, solve_legs};
+use crate::geometry::Pose2;
 use crate::params::Params;
 use crate::robot::RobotDescription;
 use crate::terrain::HeightMap;
@@ -224,25 +225,25 @@ impl StandingRule {
 }
 
 impl StandingRule {
-    /// The posture at the start of a step of leg `leg` from feet `pre` to `post_foot`
-    /// at leg height `height`: all feet still down, the step's pitch, the stepping leg
-    /// counting the higher ground (as [`Self::step_heights`] checks it).
+    /// The posture at the start of a step of leg `leg` from feet `pre` to `post_foot`,
+    /// the base at `base`, at leg height `height`: all feet still down, the step's pitch,
+    /// the stepping leg counting the higher ground (as [`Self::step_heights`] checks it).
     pub fn step_posture(
         &self,
         robot: &RobotDescription,
         pre: [[f64; 3]; 4],
         leg: usize,
         post_foot: [f64; 3],
-        xy: [f64; 2],
-        yaw: f64,
+        base: &Pose2,
         height: f64,
     ) -> Posture {
         let mut post = pre;
         post[leg] = post_foot;
-        let pitch = self.step_pitch(&pre, &post, yaw);
+        let pitch = self.step_pitch(&pre, &post, base.theta);
         let mut ground = pre.map(|f| f[2]);
         ground[leg] = pre[leg][2].max(post_foot[2]);
-        level_posture(robot, pre, [true; 4], xy, [0.0, pitch, yaw], height, ground)
+        let xy = [base.x, base.y];
+        level_posture(robot, pre, [true; 4], xy, [0.0, pitch, base.theta], height, ground)
     }
 }
 
