@@ -166,7 +166,8 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
         Err(MotionError::Step { index, leg, best_margin_m, required_m, .. }) => {
             assert_eq!(index, first);
             assert_eq!(Some(leg), p.path[first].leg);
-            assert!(best_margin_m < required_m && required_m == 0.15);
+            // (The best margin is read back from a message printed to the millimetre.)
+            assert!(best_margin_m <= required_m && required_m == 0.15, "{best_margin_m}");
         }
         other => panic!("expected a step failure, got {other:?}"),
     }
