@@ -126,15 +126,21 @@ fn check_steps(p: &PlanSummary, d: &DetailedPath) {
     assert!(d.min_three_contact_margin_m >= 0.03 && d.min_three_contact_margin_m.is_finite());
 }
 
-#[test]
-fn staircase_whole_path_is_stable() {
-    let s = scenario("staircase");
+/// Plans scenario `name`, expands the whole path and checks it ([`check`], [`check_steps`]).
+fn whole_path_checked(name: &str) -> (Scenario, Simulation, PlanSummary, DetailedPath) {
+    let s = scenario(name);
     let mut sim = sim();
     let p = planned(&s, &sim);
     let d = expand(&s, &mut sim, &p.path).expect("expansion");
     report(&s, p.path.len(), p.path.len(), &d);
     check(&d, &sim);
     check_steps(&p, &d);
+    (s, sim, p, d)
+}
+
+#[test]
+fn staircase_whole_path_is_stable() {
+    let (_, _, p, d) = whole_path_checked("staircase");
     // Rear steps up the treads, with the planner's base shifts and wheel moves between.
     let ph = phases(&d);
     assert!(ph.contains(&Phase::PlannedBaseShift) && ph.contains(&Phase::WheelMove));
@@ -143,13 +149,7 @@ fn staircase_whole_path_is_stable() {
 
 #[test]
 fn platform_whole_path_is_stable_and_failures_name_the_step() {
-    let s = scenario("platform");
-    let mut sim = sim();
-    let p = planned(&s, &sim);
-    let d = expand(&s, &mut sim, &p.path).expect("expansion");
-    report(&s, p.path.len(), p.path.len(), &d);
-    check(&d, &sim);
-    check_steps(&p, &d);
+    let (s, mut sim, p, d) = whole_path_checked("platform");
     // All four feet end on the platform. (The stabilising base shift of Fig. 12b is
     // tested where a wheel is blocked: `a_blocked_wheel_leaves_the_alignment_to_a_base_shift`.)
     assert!(d.keyframes.last().is_some_and(|k| k.feet.iter().all(|f| f[2] > 0.15)));

@@ -27,7 +27,7 @@ pub use roll::{RollError, RollSolution, roll_for_lateral_com};
 pub use standing::StandingRule;
 
 use crate::robot::RobotDescription;
-use crate::robot::ik::leg_fk;
+use crate::robot::ik::{knee_and_ankle, leg_fk};
 
 /// The whole robot's centre of mass (world frame, m) for a commanded configuration: base
 /// position, base roll/pitch/yaw (ZYX, MuJoCo's signs) and per-leg (hip, knee, ankle)
@@ -94,9 +94,8 @@ impl CenterOfMassModel for LumpedMassModel {
         let rb = &self.robot;
         for (i, q) in legs.iter().enumerate() {
             let h = rb.hips[i];
-            let knee =
-                [h[0] - rb.thigh_length * q[0].sin(), h[1], h[2] - rb.thigh_length * q[0].cos()];
-            add(world(knee), self.knee_mass);
+            let [knee, _] = knee_and_ankle(rb, *q);
+            add(world([h[0] + knee[0], h[1], h[2] + knee[1]]), self.knee_mass);
             let c = leg_fk(rb, *q, base_rpy[1]);
             let axle = [h[0] + c[0], h[1], h[2] + c[1] + rb.wheel_radius];
             add(world(axle), self.wheel_mass);

@@ -23,6 +23,7 @@ use super::kinematics::{Posture, PostureError, apply, pitch_from_feet, rotation,
 use crate::geometry::Pose2;
 use crate::params::Params;
 use crate::robot::RobotDescription;
+use crate::robot::ik::knee_and_ankle;
 use crate::terrain::HeightMap;
 
 /// The parameters of the rule.
@@ -99,13 +100,13 @@ impl StandingRule {
         let r = rotation(p.base_rpy);
         for leg in crate::robot::Leg::ALL {
             let i = leg.index();
-            let (h, q) = (robot.hips[i], joints[i]);
-            let knee =
-                [h[0] - robot.thigh_length * q[0].sin(), h[2] - robot.thigh_length * q[0].cos()];
-            let a = q[0] + q[1];
-            let ankle =
-                [knee[0] - robot.shin_length * a.sin(), knee[1] - robot.shin_length * a.cos()];
-            let chain = [[h[0], h[2]], knee, ankle];
+            let h = robot.hips[i];
+            let [knee, ankle] = knee_and_ankle(robot, joints[i]);
+            let chain = [
+                [h[0], h[2]],
+                [h[0] + knee[0], h[2] + knee[1]],
+                [h[0] + ankle[0], h[2] + ankle[1]],
+            ];
             for seg in chain.windows(2) {
                 // A quarter segment apart, far end included (the hip never dips).
                 for k in 1..=4 {
@@ -335,12 +336,10 @@ pub fn com_estimate(robot: &RobotDescription, p: &Posture) -> Result<[f64; 2], P
     let mut total = robot.body_mass;
     for (i, q) in joints.iter().enumerate() {
         let h = robot.hips[i];
-        // Sagittal chain in the base frame: a segment at angle a from straight down.
-        let knee = [h[0] - robot.thigh_length * q[0].sin(), h[2] - robot.thigh_length * q[0].cos()];
-        let a = q[0] + q[1];
-        let ankle = [knee[0] - robot.shin_length * a.sin(), knee[1] - robot.shin_length * a.cos()];
-        let thigh = world([(h[0] + knee[0]) / 2.0, h[1], (h[2] + knee[1]) / 2.0]);
-        let shin = world([(knee[0] + ankle[0]) / 2.0, h[1], (knee[1] + ankle[1]) / 2.0]);
+        let [knee, ankle] = knee_and_ankle(robot, *q);
+        let thigh = world([h[0] + knee[0] / 2.0, h[1], h[2] + knee[1] / 2.0]);
+        let shin =
+            world([h[0] + (knee[0] + ankle[0]) / 2.0, h[1], h[2] + (knee[1] + ankle[1]) / 2.0]);
         for (m, x, y) in [
             (m_thigh, thigh[0], thigh[1]),
             (m_shin, shin[0], shin[1]),

@@ -95,18 +95,22 @@ pub fn leg_ik(
     Ok(q)
 }
 
+/// The knee and the ankle (x', z') relative to the hip, in the base frame, for joint
+/// angles `q`: the thigh and shin segments of the sagittal chain.
+pub fn knee_and_ankle(robot: &RobotDescription, q: [f64; 3]) -> [[f64; 2]; 2] {
+    let (a1, a2) = (u(q[0]), u(q[0] + q[1]));
+    let knee = [robot.thigh_length * a1[0], robot.thigh_length * a1[1]];
+    [knee, [knee[0] + robot.shin_length * a2[0], knee[1] + robot.shin_length * a2[1]]]
+}
+
 /// Forward kinematics: the wheel's ground contact point (x', z') relative to the hip, in the
 /// base frame of a base pitched by `pitch`, for joint angles `q`. The contact point is the
 /// lowest point of the wheel in the world, assuming the wheel level.
 pub fn leg_fk(robot: &RobotDescription, q: [f64; 3], pitch: f64) -> [f64; 2] {
-    let (a1, a2, a3) = (u(q[0]), u(q[0] + q[1]), u(q[0] + q[1] + q[2]));
-    let down = u(-pitch);
-    let (l1, l2, lf, r) =
-        (robot.thigh_length, robot.shin_length, robot.foot_length, robot.wheel_radius);
-    [
-        l1 * a1[0] + l2 * a2[0] + lf * a3[0] + r * down[0],
-        l1 * a1[1] + l2 * a2[1] + lf * a3[1] + r * down[1],
-    ]
+    let [_, ankle] = knee_and_ankle(robot, q);
+    let (a3, down) = (u(q[0] + q[1] + q[2]), u(-pitch));
+    let (lf, r) = (robot.foot_length, robot.wheel_radius);
+    [ankle[0] + lf * a3[0] + r * down[0], ankle[1] + lf * a3[1] + r * down[1]]
 }
 
 #[cfg(test)]
