@@ -165,6 +165,10 @@ pub struct PlannerArgs {
     /// Orientation cost factor k12 (default: the scenario's, 2.0).
     #[arg(long, allow_negative_numbers = true)]
     pub k12: Option<f64>,
+    /// Step-related cost factor (default: the scenario's, 10.75, calibrated on
+    /// ramp_detour and ramp_far).
+    #[arg(long, allow_negative_numbers = true)]
+    pub step_cost_factor: Option<f64>,
 }
 
 impl PlannerArgs {
@@ -178,6 +182,7 @@ impl PlannerArgs {
             initial_epsilon: self.initial_epsilon,
             final_epsilon: self.final_epsilon,
             k12: self.k12,
+            step_cost_factor: self.step_cost_factor,
             ..jobs::plan::PlanOptions::default()
         }
     }

@@ -65,11 +65,13 @@ pub struct Params {
     ///
     /// Calibrated on `scenarios/ramp_detour.toml` (0.2 m platform 2 m ahead, a ramp whose
     /// straight-segment detour is 1.55 m longer than the direct route; the planned detour
-    /// drives 2.3 m more) with the optimal planner (ARA* run to ε = 1, k12 = 2): the plan
-    /// switches from stepping to the detour between 10.19 and 10.28 (bisection; detour
-    /// cost 49.56 against 49.44 + 4.15 · (f − 10.19) for the four-step plan). 10.5 makes
-    /// the detour just win (by 2 %), while on `scenarios/ramp_far.toml` (detour 3.8 m
-    /// longer, cost 53.0) stepping (50.6) wins. Both are asserted by
+    /// drives 2.3 m more) with the optimal planner (ARA* run to ε = 1, k12 = 2) and the
+    /// standing rule that planner and step generator share (Sec. VI-B). The optimal
+    /// four-step plan costs 12.56 + 3.519 · f (driving plus step-related terms), the
+    /// detour 49.56, so the plan switches at f = 10.51: `momaro plan` finds the four steps
+    /// at 10.5 and the detour at 10.55. 10.75 makes the detour just win (by 1.7 %), while
+    /// on `scenarios/ramp_far.toml` (detour 3.8 m longer, cost 53.0) stepping (50.39)
+    /// wins; stepping would lose there above f = 11.49. Both are asserted by
     /// `tests/planner_scenarios.rs`. The number is large because the cost client prices a
     /// 0.2 m ramp of any length at about 37 units of pose cost above flat driving
     /// (C_F ≈ 1 + 375 · slope on a plane; eq. 1).
@@ -138,7 +140,7 @@ impl Default for Params {
             k9: 2.3,
             k10: 0.5,
             k11: 0.125,
-            step_cost_factor: 10.5,
+            step_cost_factor: 10.75,
             k12: 2.0,
             orientation_free_band_rad: std::f64::consts::TAU / 60.0,
             driving_leg_height_m: 0.27,

@@ -137,6 +137,20 @@ fn bad_drive_option() {
 }
 
 #[test]
+fn bad_planner_option_names_the_parameter() {
+    let scenario = common::root().join("scenarios/flat.toml");
+    for bad in ["nan", "-1"] {
+        let out = momaro(&["plan", scenario.to_str().unwrap(), "--step-cost-factor", bad]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {stderr}");
+        assert!(
+            stderr.contains("step_cost_factor") && !stderr.contains("panicked"),
+            "{bad}: {stderr}"
+        );
+    }
+}
+
+#[test]
 fn json_summary_has_the_documented_fields() {
     let scenario = common::root().join("scenarios/flat.toml");
     let out = momaro(&["sim", scenario.to_str().unwrap(), "--duration", "1", "--json"]);

@@ -75,10 +75,6 @@ fn check_solutions(p: &PlanSummary) {
 }
 
 #[test]
-#[ignore = "issue 4, calibration to redo: since planner and step generator share the \
-            standing leg-height rule (issue 5), the optimal ramp_detour plan steps (4 steps) \
-            instead of taking the 1.5 m ramp; step_cost_factor 10.5 was bisected under the \
-            old reach model. ARA*'s first solution still drives the ramp (CI's check)."]
 fn ramp_detour_is_driven_rather_than_stepping_up() {
     let s = scenario("ramp_detour");
     let p = plan(&s, &arastar(300.0));

@@ -92,11 +92,12 @@ use crate::geometry::Pose2;
 use crate::motion::kinematics::hips_in_world;
 use crate::motion::standing::{StandingRule, com_estimate};
 use crate::params::Params;
-use crate::planner::{Cost, SearchGraph};
+use crate::planner::{Cost, FxBuild, SearchGraph};
 use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
 use crate::stability::stability_margin;
 use serde::Serialize;
+use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 /// What an edge of the hybrid graph does.
@@ -285,6 +286,10 @@ pub struct HybridGraph<'c> {
     step_bound: StepBound,
     /// Time spent building `step_bound`.
     heuristic_setup: Duration,
+    /// [`Self::target_ok`] of non-neutral footprints by (cell, orientation, offsets): a
+    /// footprint is entered from several predecessors, and each check runs the standing
+    /// rule's IK.
+    standable: HashMap<(i16, i16, u8, FootOffsets), bool, FxBuild>,
 }
 
 /// The offsets (cells, −64..=63) at which `leg` reaches its foot with the hip `height`
@@ -362,6 +367,7 @@ impl<'c> HybridGraph<'c> {
             stats: ManoeuvreStats::default(),
             step_bound,
             heuristic_setup,
+            standable: HashMap::default(),
         })
     }
 
@@ -538,21 +544,19 @@ impl<'c> HybridGraph<'c> {
         post: [f64; 3],
     ) -> Option<f64> {
         let pose = self.lattice.pose(s);
-        let pre = Self::feet_xyz(feet);
-        let rule = &self.config.standing;
-        let swing = rule.swing_z(&self.robot, self.maps.heights(), pre[leg], post);
-        rule.step_heights(
-            &self.robot,
-            self.maps.leg_terrain(),
-            pre,
-            leg,
-            post,
-            [pose.x, pose.y],
-            pose.theta,
-            swing,
-        )
-        .first()
-        .copied()
+        self.config
+            .standing
+            .step_heights(
+                &self.robot,
+                self.maps.heights(),
+                self.maps.leg_terrain(),
+                Self::feet_xyz(feet),
+                leg,
+                post,
+                [pose.x, pose.y],
+                pose.theta,
+            )
+            .next()
     }
 
     /// Whether state `t` (footprint offsets `o`) may be entered; its body cost for
@@ -561,18 +565,22 @@ impl<'c> HybridGraph<'c> {
         if *o == NEUTRAL_OFFSETS {
             return self.driving.pose_cost(t).is_some();
         }
-        let Some(feet) = self.feet_of(t, o) else {
-            return false;
-        };
         if !self.sides_ok(o)
             || !(0..4).all(|k| (self.reach[k][0]..=self.reach[k][1]).contains(&o[k]))
         {
             return false;
         }
-        let Some(legs) = self.standing_legs(t, &feet) else {
-            return false;
-        };
-        self.maps.body_cost(&self.lattice.pose(t), &feet.pos, &legs).is_finite()
+        let key = (t.i, t.j, t.theta, *o);
+        if let Some(&ok) = self.standable.get(&key) {
+            return ok;
+        }
+        let ok = self.feet_of(t, o).is_some_and(|feet| {
+            self.standing_legs(t, &feet).is_some_and(|legs| {
+                self.maps.body_cost(&self.lattice.pose(t), &feet.pos, &legs).is_finite()
+            })
+        });
+        self.standable.insert(key, ok);
+        ok
     }
 
     /// Interns `o` and returns the state at `(i, j, θ)` with that footprint.

@@ -483,7 +483,9 @@ mod hybrid {
         let lambda = c / (f * p.k7);
         let per_foot =
             Cost::from_f64_floor(f * ((1.0 - lambda) * p.k7 * l + p.k9 * 0.2) * (1.0 - 1e-9));
-        assert!((per_foot.to_f64() - 5.7845).abs() < 1e-3, "{per_foot}");
+        // By hand with f = 10.75: L = 0.21871 m, c = 0.91697, so
+        // 10.75 · (0.5 · 0.21871 + 2.3 · 0.2) − 0.91697 · 0.21871 = 5.9200.
+        assert!((per_foot.to_f64() - 5.9200).abs() < 1e-3, "{per_foot}");
         let s = state_at(&g, 0.0, 0.0);
         assert_eq!(g.heuristic(s), driving_heuristic(&g, s).saturating_add(Cost(4 * per_foot.0)));
         // Offsets (cells) add c · Σ|o|: 6 cells here (all feet stay on the floor).

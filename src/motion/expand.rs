@@ -600,17 +600,18 @@ impl Expander<'_> {
         let i = leg.index();
         let (pre, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
         let rule = self.o.standing;
-        let swing_z = rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
-        let mut heights = rule.step_heights(
-            self.robot,
-            self.maps.leg_terrain(),
-            pre,
-            i,
-            post_foot,
-            xy,
-            yaw,
-            swing_z,
-        );
+        let mut heights = rule
+            .step_heights(
+                self.robot,
+                self.maps.heights(),
+                self.maps.leg_terrain(),
+                pre,
+                i,
+                post_foot,
+                xy,
+                yaw,
+            )
+            .collect::<Vec<_>>();
         heights.extend([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1]);
         // First the paper's sequence (a base shift only where the wheel was hindered), in
         // full, half or none of each alignment; then base shifts of fixed length with

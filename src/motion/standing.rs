@@ -160,6 +160,7 @@ impl StandingRule {
                 last = Some(e);
                 continue;
             }
+
             let p = level_posture(robot, feet, [true; 4], xy, [0.0, pitch, yaw], h, ground);
             match solve_legs(robot, &p, self.reach_margin_m)
                 .and_then(|q| self.legs_clear(robot, terrain, &p, &q))
@@ -171,57 +172,74 @@ impl StandingRule {
         Err(last.unwrap_or(PostureError::NoHeight))
     }
 
-    /// The heights of [`Self::heights`] at which a step of leg `leg` from feet `pre` to
-    /// `post_foot` keeps every leg within reach: the three support feet and the stepping
-    /// foot on the ground at both ends and at `swing_z` along its straight path (every 5 cm,
-    /// ends included: a folded leg cannot pass under its hip), with the step's
-    /// pitch and the stepping leg counting the higher ground.
+    /// The heights of [`Self::heights`], tallest first and computed lazily, at which a
+    /// step of leg `leg` from feet `pre` to `post_foot` keeps every leg within reach: the
+    /// three support feet and the stepping foot on the ground at both ends and at the
+    /// swing height ([`Self::swing_z`] over `heights`) along its straight path (every
+    /// 5 cm, ends included: a folded leg cannot pass under its hip), with the step's pitch
+    /// and the stepping leg counting the higher ground; thighs and shins clear
+    /// `leg_terrain`.
     #[allow(clippy::too_many_arguments)]
-    pub fn step_heights(
-        &self,
-        robot: &RobotDescription,
-        terrain: &HeightMap,
+    pub fn step_heights<'a>(
+        &'a self,
+        robot: &'a RobotDescription,
+        heights: &HeightMap,
+        leg_terrain: &'a HeightMap,
         pre: [[f64; 3]; 4],
         leg: usize,
         post_foot: [f64; 3],
         xy: [f64; 2],
         yaw: f64,
-        swing_z: f64,
-    ) -> Vec<f64> {
+    ) -> impl Iterator<Item = f64> + use<'a> {
         let mut post = pre;
         post[leg] = post_foot;
         let pitch = self.step_pitch(&pre, &post, yaw);
         let mut ground = pre.map(|f| f[2]);
         ground[leg] = pre[leg][2].max(post_foot[2]);
         let rpy = [0.0, pitch, yaw];
-        let lifted_at = |f: [f64; 3]| {
-            let mut feet = pre;
-            feet[leg] = [f[0], f[1], swing_z];
-            feet
-        };
-        // On the ground at both ends, then the swing at most 5 cm apart, ends included.
-        let (a, b) = (pre[leg], post_foot);
-        let n = ((b[0] - a[0]).hypot(b[1] - a[1]) / SWING_SAMPLE_M).ceil().max(1.0) as usize;
+        let probe =
+            |feet: &[[f64; 3]; 4]| ReachProbe::new(robot, feet, [true; 4], xy, rpy, &ground, self);
         let mut variants = vec![pre, post];
-        variants.extend((0..=n).map(|k| {
-            let t = k as f64 / n as f64;
-            lifted_at([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, 0.0])
-        }));
-        let probes: Vec<ReachProbe> = variants
-            .iter()
-            .map(|feet| ReachProbe::new(robot, feet, [true; 4], xy, rpy, &ground, self))
-            .collect();
-        self.heights()
-            .filter(|&h| {
-                probes.iter().all(|p| p.distances_ok(h).is_ok())
-                    && variants.iter().all(|feet| {
-                        let p = level_posture(robot, *feet, [true; 4], xy, rpy, h, ground);
-                        solve_legs(robot, &p, self.reach_margin_m)
-                            .and_then(|q| self.legs_clear(robot, terrain, &p, &q))
-                            .is_ok()
-                    })
-            })
-            .collect()
+        let mut probes: Vec<ReachProbe> = variants.iter().map(probe).collect();
+        // The swing height scans the terrain around the path, the dearest part: only
+        // when both ground stances pass the distance check at some height (the planner
+        // rejects most candidate footholds right here).
+        let grounded = self.heights().any(|h| probes.iter().all(|p| p.distances_ok(h).is_ok()));
+        if grounded {
+            let swing_z = self.swing_z(robot, heights, pre[leg], post_foot);
+            // The swing at most 5 cm apart, ends included.
+            let (a, b) = (pre[leg], post_foot);
+            let n = ((b[0] - a[0]).hypot(b[1] - a[1]) / SWING_SAMPLE_M).ceil().max(1.0) as usize;
+            for k in 0..=n {
+                let t = k as f64 / n as f64;
+                let mut feet = pre;
+                feet[leg] = [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, swing_z];
+                probes.push(probe(&feet));
+                variants.push(feet);
+            }
+            // The lifted foot first: its stances fail most often.
+            variants.rotate_left(2);
+        }
+        // Lazy: the planner needs only the first (tallest) height, and each costs up to
+        // one IK and one clearance check per variant. The variant that failed is tried
+        // first at the next height: mostly the same one fails (the foot lifted at one end
+        // of its swing folds the leg past a joint limit), so a rejected height costs one
+        // IK instead of several.
+        self.heights().take(if grounded { usize::MAX } else { 0 }).filter(move |&h| {
+            if !probes.iter().all(|p| p.distances_ok(h).is_ok()) {
+                return false;
+            }
+            let failed = variants.iter().position(|feet| {
+                let p = level_posture(robot, *feet, [true; 4], xy, rpy, h, ground);
+                solve_legs(robot, &p, self.reach_margin_m)
+                    .and_then(|q| self.legs_clear(robot, leg_terrain, &p, &q))
+                    .is_err()
+            });
+            if let Some(k) = failed {
+                variants.swap(0, k);
+            }
+            failed.is_none()
+        })
     }
 }
 
@@ -465,8 +483,18 @@ mod tests {
         // Front feet on a 0.2 m platform, rear feet under their hips on the floor; the
         // rear-left foot steps 0.3 m forward onto the platform.
         let pre = [[0.35, 0.32, 0.2], [0.35, -0.32, 0.2], [-0.35, 0.32, 0.0], [-0.35, -0.32, 0.0]];
-        let hs =
-            r.step_heights(&robot, &platform(), pre, 2, [-0.05, 0.32, 0.2], [0.0, 0.0], 0.0, 0.25);
+        let hs = r
+            .step_heights(
+                &robot,
+                &platform(),
+                &platform(),
+                pre,
+                2,
+                [-0.05, 0.32, 0.2],
+                [0.0, 0.0],
+                0.0,
+            )
+            .collect::<Vec<_>>();
         assert!(!hs.is_empty());
         // Every height listed really reaches with the stepping leg over 0.2 m…
         let mut post = pre;
@@ -487,16 +515,18 @@ mod tests {
         // …and with the other rear foot 0.4 m behind its hip no height does.
         let mut stretched = pre;
         stretched[3][0] = -0.75;
-        let hs = r.step_heights(
-            &robot,
-            &platform(),
-            stretched,
-            2,
-            [-0.05, 0.32, 0.2],
-            [0.0, 0.0],
-            0.0,
-            0.25,
-        );
+        let hs = r
+            .step_heights(
+                &robot,
+                &platform(),
+                &platform(),
+                stretched,
+                2,
+                [-0.05, 0.32, 0.2],
+                [0.0, 0.0],
+                0.0,
+            )
+            .collect::<Vec<_>>();
         assert!(hs.is_empty(), "{hs:?}");
     }
 
