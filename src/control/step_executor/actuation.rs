@@ -1,0 +1,163 @@
+//! From a commanded posture to actuator targets: leg joint targets by the sagittal IK
+//! (pulling a foot just beyond reach back in), and wheel commands (pairs in contact roll
+//! at their foot's speed along the heading, steering straight, with the steering-rate
+//! feed-forward of the wheel kinematics). An IK failure here fails the step.
+
+use super::{Command, ExecFailure, Observation, StepExecutor};
+use crate::control::wheels::WheelPairCommand;
+use crate::motion::kinematics::{Posture, contacts_in_base};
+use crate::robot::ik::{IkError, leg_ik};
+use crate::robot::{Leg, RobotDescription};
+
+/// Wheel speed (rad/s) that rolls a pair steered straight along a base heading `yaw` at
+/// the foot's world velocity `v` (only the component along the heading can roll).
+pub fn rolling_wheel_speed(robot: &RobotDescription, v: [f64; 2], yaw: f64) -> f64 {
+    let (s, c) = yaw.sin_cos();
+    (c * v[0] + s * v[1]) / robot.wheel_radius
+}
+
+/// Spare reach the executor keeps when it has to pull a foot in, m.
+const REACH_SPARE_M: f64 = 0.001;
+
+/// Joint targets for `p` like `motion::kinematics::leg_joint_targets`, except that a foot
+/// beyond a leg's reach is pulled toward its hip (along the hip–ankle line) until the leg
+/// has `spare` m of reach left: the executor's corrections (landing offset, stabilising
+/// shift) may ask a few millimetres more than a posture planned at the reach limit has.
+///
+/// # Errors
+/// [`IkError`] for a joint limit or non-finite input.
+pub fn reachable_leg_targets(
+    robot: &RobotDescription,
+    p: &Posture,
+    spare: f64,
+) -> Result<[[f64; 3]; 4], IkError> {
+    let local = contacts_in_base(robot, p);
+    let pitch = p.base_rpy[1];
+    let below = robot.foot_length + robot.wheel_radius;
+    let reach = robot.thigh_length + robot.shin_length - spare;
+    // World down in the base frame (the foot segment's direction), as `leg_ik` uses it.
+    let down = [pitch.sin(), -pitch.cos()];
+    let mut q = [[0.0; 3]; 4];
+    for leg in Leg::ALL {
+        let c = local[leg.index()];
+        let mut contact = [c[0], c[2]];
+        let ankle = [contact[0] - below * down[0], contact[1] - below * down[1]];
+        let d = ankle[0].hypot(ankle[1]);
+        if d > reach {
+            let k = reach / d;
+            contact = [ankle[0] * k + below * down[0], ankle[1] * k + below * down[1]];
+        }
+        q[leg.index()] = leg_ik(robot, leg, contact, pitch)?;
+    }
+    Ok(q)
+}
+
+fn straight(speed: f64) -> WheelPairCommand {
+    WheelPairCommand { steer: 0.0, wheel_speeds: [speed, speed] }
+}
+
+impl StepExecutor {
+    pub(super) fn legs_for(&mut self, p: &Posture, time: f64) -> Option<[[f64; 3]; 4]> {
+        match reachable_leg_targets(&self.robot, p, REACH_SPARE_M) {
+            Ok(q) => {
+                self.last_legs = q;
+                Some(q)
+            }
+            Err(e) => {
+                self.fail(ExecFailure::Ik(e.to_string()), time);
+                None
+            }
+        }
+    }
+
+    /// Joint targets for `p`, or the last ones if `p` cannot be solved (while already
+    /// recovering, a failure must not start another recovery).
+    pub(super) fn legs_or_hold(&mut self, p: &Posture) -> [[f64; 3]; 4] {
+        if let Ok(q) = reachable_leg_targets(&self.robot, p, REACH_SPARE_M) {
+            self.last_legs = q;
+        }
+        self.last_legs
+    }
+
+    pub(super) fn hold(&self) -> Command {
+        Command { legs: self.last_legs, wheels: [straight(0.0); 4] }
+    }
+
+    pub(super) fn with_steer_rate(
+        &self,
+        cmd: [WheelPairCommand; 4],
+        obs: &Observation,
+    ) -> [WheelPairCommand; 4] {
+        std::array::from_fn(|i| {
+            self.config.wheels.with_steering_rate(&self.robot, cmd[i], obs.steering_rate[i])
+        })
+    }
+
+    /// Wheel commands for a posture moving at `velocity` (world feet velocities): pairs in
+    /// contact roll at their foot's speed along the heading, steering straight.
+    pub(super) fn rolling(
+        &self,
+        p: &Posture,
+        velocity: &[[f64; 2]; 4],
+        obs: &Observation,
+    ) -> [WheelPairCommand; 4] {
+        let yaw = p.base_rpy[2];
+        let cmd = std::array::from_fn(|i| {
+            if p.contact[i] {
+                straight(rolling_wheel_speed(&self.robot, velocity[i], yaw))
+            } else {
+                straight(0.0)
+            }
+        });
+        self.with_steer_rate(cmd, obs)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::step_executor::test_support::{robot, standing};
+    use crate::motion::kinematics::leg_joint_targets;
+    use crate::robot::ik::leg_fk;
+
+    #[test]
+    fn wheel_speed_is_the_foot_speed_along_the_heading_over_the_radius() {
+        // r = 0.08 m: 0.1 m/s straight ahead is 1.25 rad/s; heading 90° sees only v_y.
+        let r = robot();
+        assert!((rolling_wheel_speed(&r, [0.1, 0.0], 0.0) - 1.25).abs() < 1e-12);
+        assert!((rolling_wheel_speed(&r, [0.1, 0.0], std::f64::consts::FRAC_PI_2)).abs() < 1e-12);
+        assert!(
+            (rolling_wheel_speed(&r, [0.0, -0.04], std::f64::consts::FRAC_PI_2) + 0.5).abs()
+                < 1e-12
+        );
+        // 60°: 0.1·cos 60° = 0.05 m/s → 0.625 rad/s.
+        assert!(
+            (rolling_wheel_speed(&r, [0.1, 0.0], std::f64::consts::FRAC_PI_3) - 0.625).abs()
+                < 1e-12
+        );
+    }
+
+    #[test]
+    fn a_foot_beyond_reach_is_pulled_in_along_the_hip_ankle_line() {
+        let r = robot();
+        let mut p = standing();
+        // Hip 0.45 m above the ground: the ankle (0.18 m above the contact) 0.27 m below
+        // the hip, reachable. Moving the front-left foot 0.45 m forward puts the ankle
+        // √(0.45² + 0.27²) = 0.525 m from the hip, beyond 0.5.
+        p.feet[0][0] += 0.45;
+        assert!(leg_joint_targets(&r, &p).is_err());
+        let q = reachable_leg_targets(&r, &p, 0.001).unwrap();
+        let c = leg_fk(&r, q[0], 0.0);
+        let ankle = [c[0], c[1] + r.foot_length + r.wheel_radius];
+        assert!((ankle[0].hypot(ankle[1]) - 0.499).abs() < 1e-9);
+        // Along the line: the ankle direction is unchanged.
+        let want = 0.45f64.atan2(0.27);
+        assert!((ankle[0].atan2(-ankle[1]) - want).abs() < 1e-9);
+        // Reachable feet are untouched.
+        let local = contacts_in_base(&r, &p);
+        for i in 1..4 {
+            let f = leg_fk(&r, q[i], 0.0);
+            assert!((f[0] - local[i][0]).abs() < 1e-9 && (f[1] - local[i][2]).abs() < 1e-9);
+        }
+    }
+}

@@ -1,0 +1,193 @@
+//! Feet coming down: after the place keyframe, weight goes back onto the foot only when
+//! MuJoCo reports contact (`ContactConfirm`, bounded extra lowering; no contact fails the
+//! step); a foot put down in an emergency or before a recovery is lowered until contact,
+//! then the step is retried from its lift or the robot recovers.
+
+use super::{AfterPutDown, Command, ExecEventKind, ExecFailure, Mode, Observation, StepExecutor};
+use crate::control::foot_contact::{ContactConfirm, ContactConfirmConfig, ContactStatus};
+use crate::robot::Leg;
+
+impl StepExecutor {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn confirm_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        index: usize,
+        mut confirm: ContactConfirm,
+    ) -> Command {
+        let time = obs.time;
+        let leg = self.keys[index].leg.unwrap_or(Leg::FrontLeft);
+        let status = confirm.update(obs.leg_in_contact(leg), dt);
+        let i = leg.index();
+        match status {
+            ContactStatus::Pending { extra_m } | ContactStatus::Confirmed { extra_m } => {
+                self.foot_offset[i][2] = -extra_m;
+            }
+            ContactStatus::Failed { .. } => {}
+        }
+        let p = self.with_offsets(&self.cmd);
+        let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
+        let wheels = self.rolling(&p, &[[0.0; 2]; 4], obs);
+        match status {
+            ContactStatus::Pending { .. } => {
+                self.mode = Mode::Confirm { index, confirm };
+            }
+            ContactStatus::Confirmed { extra_m } => {
+                self.steps_executed += 1;
+                self.active = None;
+                self.event(time, ExecEventKind::StepExecuted { leg, extra_m });
+                self.fading = Some(self.correction);
+                self.advance(index + 1, time);
+            }
+            ContactStatus::Failed { extra_m } => {
+                self.steps_aborted += 1;
+                self.cmd.contact[i] = false;
+                self.fail(ExecFailure::NoContact { leg, extra_m }, time);
+            }
+        }
+        Command { legs, wheels }
+    }
+
+    pub(super) fn start_put_down(&mut self, leg: Leg, then: AfterPutDown) {
+        // Fold the offsets of this leg into the commanded posture and lower from there.
+        let i = leg.index();
+        let p = self.with_offsets(&self.cmd);
+        self.cmd.feet[i] = p.feet[i];
+        self.foot_offset[i] = [0.0; 3];
+        // The lowest ground the foot was planned on, minus the extra lowering allowed.
+        let floor = self
+            .keys
+            .iter()
+            .filter(|k| k.leg == Some(leg))
+            .map(|k| k.feet[i][2])
+            .fold(self.cmd.feet[i][2], f64::min)
+            - self.config.contact.max_extra_m;
+        self.mode = Mode::PutDown {
+            leg,
+            lowered: 0.0,
+            floor,
+            confirm: ContactConfirm::new(ContactConfirmConfig {
+                max_extra_m: f64::INFINITY,
+                ..self.config.contact
+            }),
+            then,
+        };
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn put_down_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        leg: Leg,
+        mut lowered: f64,
+        floor: f64,
+        mut confirm: ContactConfirm,
+        then: AfterPutDown,
+    ) -> Command {
+        let time = obs.time;
+        let i = leg.index();
+        let status = confirm.update(obs.leg_in_contact(leg), dt);
+        if matches!(status, ContactStatus::Pending { .. }) {
+            let z = self.cmd.feet[i][2] - lowered;
+            if z > floor {
+                lowered += self.config.put_down_speed_mps * dt;
+            }
+        }
+        let mut p = self.cmd;
+        p.feet[i][2] -= lowered;
+        let p_off = self.with_offsets(&p);
+        let legs = self.legs_or_hold(&p_off);
+        let wheels = self.rolling(&p_off, &[[0.0; 2]; 4], obs);
+        let at_floor = self.cmd.feet[i][2] - lowered <= floor;
+        match status {
+            ContactStatus::Confirmed { .. } => {
+                self.cmd = p;
+                self.cmd.contact[i] = true;
+                match then {
+                    AfterPutDown::Retry(lift) => {
+                        self.mode = Mode::Guard {
+                            index: lift,
+                            wait: 0.0,
+                            attempts: 0,
+                            corr_from: self.correction,
+                        };
+                    }
+                    AfterPutDown::Recover(f) => self.start_recover(f),
+                }
+            }
+            _ if at_floor => {
+                let f = ExecFailure::NoContact { leg, extra_m: lowered };
+                self.event(time, ExecEventKind::Failure { failure: f.clone() });
+                self.mode = Mode::Stopped(f);
+            }
+            _ => self.mode = Mode::PutDown { leg, lowered, floor, confirm, then },
+        }
+        Command { legs, wheels }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::control::step_executor::test_support::{
+        all_contacts, config, ground, obs, robot, step_path,
+    };
+    use crate::control::step_executor::{ExecEventKind, ExecFailure, ExecStatus, StepExecutor};
+    use crate::motion::Phase;
+    use crate::robot::Leg;
+
+    #[test]
+    fn a_step_lifts_after_the_margin_check_and_ends_only_on_contact() {
+        let keys = step_path();
+        let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+        let feet = keys[0].feet;
+        // The CoM 0.14 m inside the FR–RL diagonal (which passes through the origin).
+        let com = [-0.1, -0.1, 0.4];
+        let without_fl: Vec<_> =
+            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        let mut t = 0.0;
+        let mut lifted_at = None;
+        let mut status = ExecStatus::Running;
+        // Until the foot is placed, MuJoCo reports no contact of FL.
+        for _ in 0..1000 {
+            t += 0.01;
+            let (_, st) = ex.tick(&obs(t, &ex, &without_fl, com), 0.01);
+            status = st;
+            if lifted_at.is_none() && ex.active_step().is_some() {
+                lifted_at = Some(t);
+            }
+        }
+        // Lifted after the 0.3 s settle, the step not done without contact, the foot
+        // lowered by the full extra distance (5 cm), then failed.
+        let lifted_at = lifted_at.expect("lifted");
+        assert!((lifted_at - 0.3).abs() < 0.02, "{lifted_at}");
+        assert_eq!(ex.steps_executed, 0);
+        assert_eq!(ex.steps_aborted, 1);
+        assert!(ex.events.iter().any(|e| matches!(
+            e.event,
+            ExecEventKind::Failure { failure: ExecFailure::NoContact { leg: Leg::FrontLeft, .. } }
+        )));
+        assert!(
+            matches!(status, ExecStatus::NeedsReplan(ExecFailure::NoContact { .. })),
+            "{status:?}"
+        );
+
+        // The same with contact reported once the foot is down: the step is executed.
+        let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+        let placed = keys[3].feet;
+        let mut t = 0.0;
+        for _ in 0..1000 {
+            t += 0.01;
+            // FL touches once it is being placed.
+            let down = matches!(ex.phase(), Some(Phase::Place) | None);
+            let c = if down { all_contacts(&placed) } else { without_fl.clone() };
+            let (_, st) = ex.tick(&obs(t, &ex, &c, com), 0.01);
+            if st == ExecStatus::Finished {
+                break;
+            }
+        }
+        assert_eq!(ex.steps_executed, 1, "{:?}", ex.events);
+        assert_eq!(ex.steps_aborted, 0);
+    }
+}

@@ -1,0 +1,72 @@
+//! Drive runs: consecutive drive keyframes are handed to the B-spline path follower
+//! (Sec. IX) and the omnidirectional wheel kinematics, while the legs hold the keyframes'
+//! posture interpolated at the robot's progress along the run. The follower's end of the
+//! run hands over to the next keyframe; too large a cross-track error fails.
+
+use super::{Command, ExecFailure, Mode, Observation, StepExecutor};
+use crate::control::path_follower::{FollowerStatus, PathFollower};
+use crate::geometry::wrap_angle;
+use crate::motion::kinematics::{contacts_in_base, interpolate};
+
+impl StepExecutor {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn drive_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        mut follower: Box<PathFollower>,
+        first: usize,
+        last: usize,
+    ) -> Command {
+        let time = obs.time;
+        let out = follower.update(obs.base, dt);
+        if out.status == FollowerStatus::Finished {
+            self.cmd = self.keys[last].posture();
+            self.advance(last + 1, time);
+            return self.hold();
+        }
+        if out.cross_track_m.abs() > self.config.drift_tolerance_m {
+            self.cmd = self.keys[(first - 1 + out.progress_index).min(last)].posture();
+            self.fail(
+                ExecFailure::Drift {
+                    distance_m: out.cross_track_m.abs(),
+                    heading_rad: out.heading_error_rad,
+                },
+                time,
+            );
+            return self.hold();
+        }
+        // The keyframe posture at the robot's progress along the run.
+        let path = follower.path();
+        let k = out.progress_index.min(path.len() - 1);
+        let a_idx = first - 1 + k;
+        let p = if k + 1 < path.len() {
+            let (a, b) = (path[k], path[k + 1]);
+            let (dx, dy) = (b.x - a.x, b.y - a.y);
+            let len2 = dx * dx + dy * dy;
+            let t = if len2 > 1e-8 {
+                ((obs.base.x - a.x) * dx + (obs.base.y - a.y) * dy) / len2
+            } else {
+                let dth = wrap_angle(b.theta - a.theta);
+                if dth.abs() > 1e-6 { wrap_angle(obs.base.theta - a.theta) / dth } else { 1.0 }
+            };
+            interpolate(
+                &self.keys[a_idx].posture(),
+                &self.keys[a_idx + 1].posture(),
+                t.clamp(0.0, 1.0),
+            )
+        } else {
+            self.keys[a_idx].posture()
+        };
+        self.cmd = p;
+        self.wheel_hold = [None; 4];
+        self.mode = Mode::Drive { follower, first, last };
+        let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
+        let local = contacts_in_base(&self.robot, &p);
+        let feet: [[f64; 2]; 4] = std::array::from_fn(|i| {
+            [local[i][0] + self.robot.hips[i][0], local[i][1] + self.robot.hips[i][1]]
+        });
+        let wheels = self.config.wheels.commands(&self.robot, out.twist, &feet, &obs.steering);
+        Command { legs, wheels: self.with_steer_rate(wheels, obs) }
+    }
+}

@@ -1,0 +1,217 @@
+//! The lift margin guard: before a foot is lifted, the support margin measured from
+//! MuJoCo must reach the lift threshold plus reserve (more per retry); if it does not, the
+//! base is moved toward the support centroid in bounded increments (a base shift
+//! longitudinally, a roll about the ground laterally: [`correction_roll`]), else the step
+//! is aborted. At the lift the landing offset ([`landing_offset`]) of the swing foot is
+//! frozen.
+
+use super::timing::smoothstep;
+use super::{
+    ActiveStep, Command, ExecEventKind, ExecFailure, Mode, Observation, StepExecutor, planar,
+};
+use crate::geometry::{Pose2, wrap_angle};
+use crate::motion::kinematics::Posture;
+use crate::robot::Leg;
+
+/// The planar offset (m) to add to a world foothold `foothold` so that, with the robot
+/// displaced from its commanded base `commanded` to the measured `measured`, a foot
+/// commanded there relative to the commanded base lands on the foothold.
+pub fn landing_offset(commanded: Pose2, measured: Pose2, foothold: [f64; 2]) -> [f64; 2] {
+    let dth = wrap_angle(measured.theta - commanded.theta);
+    let (s, c) = (-dth).sin_cos();
+    let rel = [foothold[0] - measured.x, foothold[1] - measured.y];
+    let p = [commanded.x + c * rel[0] - s * rel[1], commanded.y + s * rel[0] + c * rel[1]];
+    [p[0] - foothold[0], p[1] - foothold[1]]
+}
+
+/// The roll that goes with a stabilising base offset `correction` (world x, y) of posture
+/// `p`: the legs only move in their sagittal planes, so the base can move sideways over
+/// planted feet only by rolling about the ground under it (as the roll of eqs. 6–8 does):
+/// a lateral offset `lat` (along the base's y') at a height `h` of the base above the mean
+/// ground of the feet in contact is a roll of −lat/h (roll positive: left side up).
+pub fn correction_roll(p: &Posture, correction: [f64; 2]) -> f64 {
+    let (s, c) = p.base_rpy[2].sin_cos();
+    let lat = -s * correction[0] + c * correction[1];
+    if lat == 0.0 {
+        return 0.0;
+    }
+    let feet: Vec<f64> = (0..4).filter(|&i| p.contact[i]).map(|i| p.feet[i][2]).collect();
+    let ground = if feet.is_empty() { 0.0 } else { feet.iter().sum::<f64>() / feet.len() as f64 };
+    let h = (p.base_position[2] - ground).max(0.1);
+    -lat / h
+}
+
+impl StepExecutor {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn guard_tick(
+        &mut self,
+        obs: &Observation,
+        dt: f64,
+        index: usize,
+        mut wait: f64,
+        mut attempts: usize,
+        corr_from: [f64; 2],
+    ) -> Command {
+        let time = obs.time;
+        let leg = self.keys[index].leg.unwrap_or(Leg::FrontLeft);
+        let c = self.config.clone();
+        wait += dt;
+        let ramp = if attempts == 0 { 1.0 } else { smoothstep(wait / c.correction_time_s) };
+        let target = self.correction;
+        let applied = [
+            corr_from[0] + (target[0] - corr_from[0]) * ramp,
+            corr_from[1] + (target[1] - corr_from[1]) * ramp,
+        ];
+        let saved = self.correction;
+        self.correction = applied;
+        let p = self.with_offsets(&self.cmd);
+        self.correction = saved;
+        let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
+        let ready = wait >= c.lift_settle_s + if attempts == 0 { 0.0 } else { c.correction_time_s };
+        if !ready {
+            self.mode = Mode::Guard { index, wait, attempts, corr_from };
+            return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
+        }
+        let m = obs.support_margin(leg);
+        let required = c.min_lift_margin_m
+            + c.lift_margin_reserve_m
+            + self.retries as f64 * c.retry_margin_increment_m;
+        if m >= required {
+            self.event(time, ExecEventKind::Lift { leg, margin_m: m });
+            if self.retries == 0 {
+                self.steps_started += 1;
+            }
+            self.active = Some(ActiveStep { number: self.steps_started, leg });
+            self.lift_offset = self.foot_offset[leg.index()];
+            // Landing: the drift of the measured base, frozen now.
+            let place = self.place_index(index);
+            let foothold = self.keys[place].feet[leg.index()];
+            self.landing = landing_offset(planar(&p), obs.base, [foothold[0], foothold[1]]);
+            self.fading = None;
+            self.start_segment(index);
+            return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
+        }
+        let centroid = obs.support_centroid(leg);
+        let total = self.correction[0].hypot(self.correction[1]);
+        if attempts < c.max_correction_attempts
+            && total < c.max_correction_m - 1e-6
+            && let Some(cen) = centroid
+        {
+            let dir = [cen[0] - obs.com[0], cen[1] - obs.com[1]];
+            let n = dir[0].hypot(dir[1]).max(1e-9);
+            let want = (required + 0.01 - m) / 0.8;
+            let mut next =
+                [self.correction[0] + want * dir[0] / n, self.correction[1] + want * dir[1] / n];
+            let len = next[0].hypot(next[1]);
+            if len > c.max_correction_m {
+                next = next.map(|v| v * c.max_correction_m / len);
+            }
+            let from = self.correction;
+            self.correction = next;
+            self.event(
+                time,
+                ExecEventKind::Correction {
+                    leg,
+                    margin_m: m,
+                    correction_m: next[0].hypot(next[1]),
+                },
+            );
+            attempts += 1;
+            self.mode = Mode::Guard { index, wait: 0.0, attempts, corr_from: from };
+            return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
+        }
+        self.steps_aborted += 1;
+        self.fail(ExecFailure::StepAborted { leg, margin_m: m, required_m: required }, time);
+        Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::step_executor::test_support::{
+        all_contacts, config, ground, obs, robot, standing, step_path,
+    };
+    use crate::control::step_executor::{ExecStatus, ExecutorConfig};
+
+    #[test]
+    fn a_lateral_correction_is_a_roll_about_the_ground() {
+        // Base 0.5 m above flat ground facing +y (yaw 90°): a world offset of −0.05 m in x
+        // is 0.05 m to the base's left, a roll of −0.05 / 0.5 = −0.1 rad (right side up);
+        // an offset along the heading needs no roll.
+        let mut p = standing();
+        p.base_rpy[2] = std::f64::consts::FRAC_PI_2;
+        assert!((correction_roll(&p, [-0.05, 0.0]) + 0.1).abs() < 1e-12);
+        assert!(correction_roll(&p, [0.0, 0.03]).abs() < 1e-12);
+        // Only the feet in contact set the ground: FL lifted to 0.1 m changes nothing.
+        p.feet[0][2] = 0.1;
+        p.contact[0] = false;
+        assert!((correction_roll(&p, [-0.05, 0.0]) + 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn landing_offset_undoes_the_drift() {
+        // Pure translation: the robot stands 2 cm ahead and 1 cm left of its command; the
+        // foot must be commanded 2 cm behind and 1 cm right of the foothold.
+        let o = landing_offset(Pose2::new(1.0, 0.0, 0.0), Pose2::new(1.02, 0.01, 0.0), [1.4, 0.3]);
+        assert!((o[0] + 0.02).abs() < 1e-12 && (o[1] + 0.01).abs() < 1e-12);
+        // Pure rotation by +0.1 rad about the base: the foothold 0.4 m ahead is commanded
+        // at 0.4·(cos 0.1, −sin 0.1) relative to the base.
+        let o = landing_offset(Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.0, 0.0, 0.1), [0.4, 0.0]);
+        assert!((o[0] - (0.4 * 0.1f64.cos() - 0.4)).abs() < 1e-12);
+        assert!((o[1] + 0.4 * 0.1f64.sin()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_low_margin_is_corrected_toward_the_centroid_then_the_step_is_aborted() {
+        let keys = step_path();
+        let cfg = ExecutorConfig { max_correction_m: 0.2, ..config() };
+        let mut ex = StepExecutor::new(&robot(), cfg, keys.clone(), ground());
+        let feet = keys[0].feet;
+        let without_fl: Vec<_> =
+            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        // The CoM 1 cm inside the FR–RL diagonal (x = −y·0.35/0.32 through the origin):
+        // a measured margin of 1 cm, below the 2 cm (plus reserve) to lift. It does not
+        // move (the corrections have no effect here), so after three corrections the step
+        // is aborted with the foot never lifted.
+        let n = [0.32f64, 0.35];
+        let len = n[0].hypot(n[1]);
+        let com = [-0.01 * n[0] / len, -0.01 * n[1] / len, 0.4];
+        let o = obs(0.0, &ex, &without_fl, com);
+        assert!((o.support_margin(Leg::FrontLeft) - 0.01).abs() < 1e-9);
+        let mut t = 0.0;
+        let mut status = ExecStatus::Running;
+        for _ in 0..600 {
+            t += 0.01;
+            let (cmd, st) = ex.tick(&obs(t, &ex, &without_fl, com), 0.01);
+            assert!(ex.active_step().is_none(), "lifted at {t}");
+            // Stance wheels held until the abort (then the feet roll back to neutral).
+            if ex.steps_aborted == 0 {
+                assert!(cmd.wheels.iter().all(|w| w.wheel_speeds == [0.0, 0.0]));
+            }
+            status = st;
+        }
+        let corrections: Vec<f64> = ex
+            .events
+            .iter()
+            .filter_map(|e| match e.event {
+                ExecEventKind::Correction { correction_m, .. } => Some(correction_m),
+                _ => None,
+            })
+            .collect();
+        // The lift needs 2 + 3 (reserve) cm; each increment aims 1 cm above:
+        // (0.05 + 0.01 − 0.01) / 0.8 = 6.25 cm, three of them.
+        assert_eq!(corrections.len(), 3, "{:?}", ex.events);
+        assert!((corrections[0] - 0.0625).abs() < 1e-9, "{corrections:?}");
+        assert!((corrections[1] - 0.125).abs() < 1e-9);
+        assert!((corrections[2] - 0.1875).abs() < 1e-9);
+        assert_eq!(ex.steps_aborted, 1);
+        assert!(
+            matches!(
+                status,
+                ExecStatus::NeedsReplan(ExecFailure::StepAborted { leg: Leg::FrontLeft, .. })
+            ),
+            "{status:?}"
+        );
+    }
+}

@@ -1,0 +1,259 @@
+//! What the step executor exchanges with its caller (`jobs::run`): its tuning
+//! ([`ExecutorConfig`]), what it sees each tick ([`Observation`]), the actuator targets it
+//! returns ([`Command`]), its status ([`ExecStatus`]), why it left the plan
+//! ([`ExecFailure`]) and the events it records for the run's summary ([`ExecEvent`]).
+
+use crate::control::foot_contact::ContactConfirmConfig;
+use crate::control::path_follower::FollowerConfig;
+use crate::control::wheels::{WheelKinematics, WheelPairCommand};
+use crate::geometry::Pose2;
+use crate::motion::kinematics::support_centroid;
+use crate::params::Params;
+use crate::robot::Leg;
+use crate::stability::stability_margin;
+use serde::Serialize;
+
+/// Tuning of the executor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExecutorConfig {
+    /// Support margin (CoM over the three support legs' contacts) required to lift a foot,
+    /// m. From `Params::min_lift_margin_m` (2 cm).
+    pub min_lift_margin_m: f64,
+    /// Margin asked before a lift on top of `min_lift_margin_m`, m: when the foot unloads,
+    /// the compliant support legs let the CoM sag toward it (measured in MuJoCo: 2.5–3 cm
+    /// on the platform's and the staircase's front steps up), so the margin during the step
+    /// stays above the threshold only if it starts this much higher.
+    pub lift_margin_reserve_m: f64,
+    /// With a foot in the air, a support margin below this puts the foot down, m.
+    pub emergency_margin_m: f64,
+    /// Time the posture is held before the margin is measured for a lift, s.
+    pub lift_settle_s: f64,
+    /// Gain of the stance wheels' angle hold (speed command per rad of creep), 1/s.
+    pub wheel_hold_gain: f64,
+    /// Largest stabilising base correction toward the support centroid, m.
+    pub max_correction_m: f64,
+    /// Time over which a correction increment is applied, s.
+    pub correction_time_s: f64,
+    /// Correction increments tried before a step is aborted.
+    pub max_correction_attempts: usize,
+    /// Retries of a step whose foot had to be put down.
+    pub max_step_retries: usize,
+    /// Extra margin required to lift per retry of a step, m: the margin lost when the
+    /// foot unloaded last time must be made up by more correction.
+    /// (The lift needs `min_lift_margin_m + lift_margin_reserve_m + retries · this`.)
+    pub retry_margin_increment_m: f64,
+    /// Measured base farther than this from the commanded one (planar) needs a replan, m.
+    pub drift_tolerance_m: f64,
+    /// Measured heading farther than this from the commanded one needs a replan, rad.
+    pub drift_tolerance_rad: f64,
+    /// Joint tracking error from which the segment clock slows down, rad.
+    pub slowdown_start_rad: f64,
+    /// Joint tracking error at which the segment clock runs at its slowest, rad.
+    pub slowdown_full_rad: f64,
+    /// Slowest segment clock rate (fraction of real time).
+    pub slowest_rate: f64,
+    /// Joint tracking error below which a finished segment counts as reached, rad.
+    pub settle_tolerance_rad: f64,
+    /// Longest wait for the servos at a segment's end, s.
+    pub max_settle_s: f64,
+    /// Speed of a foot put down in an emergency, m/s.
+    pub put_down_speed_mps: f64,
+    /// Base and foot speed of the return to the driving posture, m/s.
+    pub recover_speed_mps: f64,
+    /// Angular speed of the return to the driving posture, rad/s.
+    pub recover_angular_speed: f64,
+    /// Driving leg height for the return to the driving posture, m.
+    pub driving_leg_height_m: f64,
+    /// Base pitch as a fraction of the slope (Sec. VI-B).
+    pub pitch_fraction: f64,
+    /// Contact confirmation of a placed foot.
+    pub contact: ContactConfirmConfig,
+    /// The path follower of drive runs.
+    pub follower: FollowerConfig,
+    /// Wheel kinematics of drive runs.
+    pub wheels: WheelKinematics,
+}
+
+impl ExecutorConfig {
+    /// The defaults with the paper's and the scenario's constants from `params`.
+    pub fn from_params(params: &Params, follower: FollowerConfig) -> Self {
+        Self {
+            min_lift_margin_m: params.min_lift_margin_m,
+            lift_margin_reserve_m: 0.03,
+            emergency_margin_m: params.min_lift_margin_m / 2.0,
+            lift_settle_s: 0.3,
+            wheel_hold_gain: 5.0,
+            max_correction_m: 0.06,
+            correction_time_s: 0.8,
+            max_correction_attempts: 3,
+            max_step_retries: 2,
+            retry_margin_increment_m: 0.03,
+            drift_tolerance_m: 0.15,
+            drift_tolerance_rad: 0.25,
+            slowdown_start_rad: 0.05,
+            slowdown_full_rad: 0.2,
+            slowest_rate: 0.2,
+            settle_tolerance_rad: 0.03,
+            max_settle_s: 1.5,
+            put_down_speed_mps: 0.25,
+            recover_speed_mps: 0.1,
+            recover_angular_speed: 0.2,
+            driving_leg_height_m: params.driving_leg_height_m,
+            pitch_fraction: params.base_pitch_slope_fraction,
+            contact: ContactConfirmConfig::default(),
+            follower,
+            wheels: WheelKinematics::default(),
+        }
+    }
+}
+
+/// What the executor sees each tick.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observation {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Measured planar base pose.
+    pub base: Pose2,
+    /// Measured hip, knee, ankle angles per leg, rad.
+    pub joints: [[f64; 3]; 4],
+    /// Measured steering angles, rad.
+    pub steering: [f64; 4],
+    /// Measured steering rates, rad/s.
+    pub steering_rate: [f64; 4],
+    /// Measured wheel angles (left, right) per leg, rad.
+    pub wheel_angles: [[f64; 2]; 4],
+    /// Whole-robot CoM, m.
+    pub com: [f64; 3],
+    /// Horizontal contact points of the wheels touching terrain, with their legs.
+    pub wheel_contacts: Vec<(Leg, [f64; 2])>,
+}
+
+impl Observation {
+    /// Whether a wheel of `leg` touches terrain.
+    pub fn leg_in_contact(&self, leg: Leg) -> bool {
+        self.wheel_contacts.iter().any(|(l, _)| *l == leg)
+    }
+
+    /// Margin of the CoM over the contacts of every leg but `lifted`, m.
+    pub fn support_margin(&self, lifted: Leg) -> f64 {
+        let pts: Vec<[f64; 2]> =
+            self.wheel_contacts.iter().filter(|(l, _)| *l != lifted).map(|(_, p)| *p).collect();
+        stability_margin(&pts, [self.com[0], self.com[1]])
+    }
+
+    /// Centroid of the contacts of every leg but `lifted` (vertex mean of their hull).
+    pub fn support_centroid(&self, lifted: Leg) -> Option<[f64; 2]> {
+        let pts: Vec<[f64; 2]> =
+            self.wheel_contacts.iter().filter(|(l, _)| *l != lifted).map(|(_, p)| *p).collect();
+        support_centroid(&pts)
+    }
+}
+
+/// Actuator targets of one tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Command {
+    /// Hip, knee, ankle position targets per leg, rad.
+    pub legs: [[f64; 3]; 4],
+    /// Steering and wheel speed targets per leg.
+    pub wheels: [WheelPairCommand; 4],
+}
+
+/// Why the executor stopped following the plan.
+#[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ExecFailure {
+    /// The support margin stayed below the lift threshold after the corrections.
+    #[error("step of {leg:?} aborted: support margin {margin_m:.3} m below {required_m:.3} m")]
+    StepAborted {
+        /// The stepping leg.
+        leg: Leg,
+        /// Margin measured at the last check, m.
+        margin_m: f64,
+        /// Required margin, m.
+        required_m: f64,
+    },
+    /// A foot found no contact within the extra lowering.
+    #[error("step of {leg:?} failed: no contact {extra_m:.3} m below the foothold")]
+    NoContact {
+        /// The leg.
+        leg: Leg,
+        /// Extra lowering tried, m.
+        extra_m: f64,
+    },
+    /// The robot drifted from the plan.
+    #[error("drifted {distance_m:.3} m / {heading_rad:.3} rad from the plan")]
+    Drift {
+        /// Planar distance, m.
+        distance_m: f64,
+        /// Heading difference, rad.
+        heading_rad: f64,
+    },
+    /// A posture could not be solved.
+    #[error("leg IK: {0}")]
+    Ik(String),
+    /// The path follower rejected a drive run.
+    #[error("path follower: {0}")]
+    Follower(String),
+}
+
+/// What the executor is doing after a tick.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExecStatus {
+    /// Executing the path.
+    Running,
+    /// The last keyframe is reached.
+    Finished,
+    /// The plan was left (see the failure); the robot stands in the driving posture and
+    /// needs a new plan.
+    NeedsReplan(ExecFailure),
+}
+
+/// Something the executor did, for the run's summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ExecEventKind {
+    /// The margin check passed and the foot is lifted.
+    Lift {
+        /// The leg.
+        leg: Leg,
+        /// Support margin measured before lifting, m.
+        margin_m: f64,
+    },
+    /// A stabilising base correction toward the support centroid.
+    Correction {
+        /// The stepping leg.
+        leg: Leg,
+        /// Support margin measured, m.
+        margin_m: f64,
+        /// Total correction now commanded, m.
+        correction_m: f64,
+    },
+    /// The placed foot touches the terrain: the step is done.
+    StepExecuted {
+        /// The leg.
+        leg: Leg,
+        /// Extra lowering needed for contact, m.
+        extra_m: f64,
+    },
+    /// A foot in the air was put down because the support margin fell.
+    FootPutDown {
+        /// The leg.
+        leg: Leg,
+        /// Margin that triggered it, m.
+        margin_m: f64,
+    },
+    /// The plan was left.
+    Failure {
+        /// Why.
+        failure: ExecFailure,
+    },
+}
+
+/// A timed [`ExecEventKind`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ExecEvent {
+    /// Simulated time, s.
+    pub time_s: f64,
+    /// What happened.
+    pub event: ExecEventKind,
+}

@@ -1,0 +1,324 @@
+//! The closed-loop step executor (issue 7): executes a detailed path's keyframes
+//! (`motion::DetailedPath`, Sec. VI) on the robot, one control tick at a time.
+//!
+//! A pure state machine: each tick it takes an [`Observation`] (measured base pose,
+//! joints, steering, MuJoCo's CoM and the wheels MuJoCo reports touching terrain) and
+//! returns actuator targets ([`Command`]). The simulation loop lives in `jobs::run`.
+//!
+//! - **Drive** runs (consecutive [`Phase::Drive`] keyframes) go to the B-spline
+//!   [`PathFollower`] (Sec. IX) and the omnidirectional wheel kinematics; the legs hold the
+//!   keyframes' posture interpolated at the robot's progress. The follower stops at the run's
+//!   end (within its 2 cm / 2° goal tolerance) and stepping starts at once.
+//! - **Other segments** track the linear interpolation between keyframes with a smoothstep
+//!   time law over the generator's keyframe time (longer if the servos lag): leg joint
+//!   targets from the sagittal IK of the interpolated posture (base height, roll, pitch,
+//!   feet). A foot moved along the ground in contact (wheel to centre, wheel back, wheel
+//!   moves) rolls its pair at the foot's world speed over the wheel radius, steering
+//!   straight. Stance wheels need no spin (the ankle keeps a planted wheel level); since
+//!   the wheel actuators are velocity servos, a stance pair holds its wheel angles with a
+//!   proportional loop so the foot does not creep under the legs' horizontal forces.
+//! - **Before a lift** the support margin measured from MuJoCo (CoM over the wheel
+//!   contacts of the three support legs) must reach [`ExecutorConfig::min_lift_margin_m`]
+//!   (2 cm) plus a reserve for the sag of the compliant support legs when the foot unloads
+//!   ([`ExecutorConfig::lift_margin_reserve_m`]). If it does not, the base is moved toward
+//!   the support triangle's centroid in bounded increments: longitudinally by a base shift,
+//!   laterally by a roll about the ground ([`correction_roll`]; the legs move only in their
+//!   sagittal planes). If that does not suffice, the step is aborted (the foot is not
+//!   lifted).
+//! - **While a foot is in the air** the support margin is watched; below
+//!   [`ExecutorConfig::emergency_margin_m`] the foot is put down where it is (lowered until
+//!   MuJoCo reports contact), and the step is retried from the lift (bounded).
+//! - **Swing foot landing**: the planar drift of the measured base from the commanded one,
+//!   frozen at the lift, is taken out of the foothold, so the foot lands on the world
+//!   foothold rather than on the plan's.
+//! - **Placing**: after the place keyframe, weight goes back onto the foot only when
+//!   MuJoCo reports contact ([`ContactConfirm`]: the foot is lowered a bounded extra
+//!   distance; no contact fails the step).
+//! - **Failures** (step aborted or failed, drift beyond tolerance, IK): a lifted foot is put
+//!   down, the robot returns to the driving posture at its pose (feet rolled to the
+//!   neutral footprint) and the executor reports [`ExecStatus::NeedsReplan`].
+//!
+//! Postures are kept in the plan's coordinates; only the relative geometry of base and
+//! feet reaches the joints, so a small planar offset of the whole robot from the plan does
+//! not disturb stepping.
+//!
+//! The executor is cut by job: `interface` (configuration, observation, command, status,
+//! events, failures), `timing` (time laws and segment clock), `actuation` (postures to
+//! joint and wheel targets), `drive` (drive runs handed to the path follower), `segment`
+//! (keyframe tracking, watching the margin of a foot in the air), `guard` (the margin
+//! check and stabilising corrections before a lift, the landing offset), `contact`
+//! (contact confirmation of a placed foot, the emergency put-down) and `recovery` (the
+//! return to the driving posture). This file holds the state machine itself: its modes,
+//! its state, and the tick that dispatches on the mode.
+
+mod actuation;
+mod contact;
+mod drive;
+mod guard;
+mod interface;
+mod recovery;
+mod segment;
+#[cfg(test)]
+mod test_support;
+mod timing;
+
+pub use actuation::{reachable_leg_targets, rolling_wheel_speed};
+pub use guard::{correction_roll, landing_offset};
+pub use interface::{
+    Command, ExecEvent, ExecEventKind, ExecFailure, ExecStatus, ExecutorConfig, Observation,
+};
+pub use timing::{clock_rate, motion_duration, smoothstep, smoothstep_rate};
+
+use super::foot_contact::ContactConfirm;
+use super::path_follower::PathFollower;
+use crate::geometry::Pose2;
+use crate::motion::kinematics::Posture;
+use crate::motion::{Keyframe, Phase};
+use crate::robot::{Leg, RobotDescription};
+use crate::terrain::HeightMap;
+
+fn planar(p: &Posture) -> Pose2 {
+    Pose2::new(p.base_position[0], p.base_position[1], p.base_rpy[2])
+}
+
+/// What follows a foot put down.
+#[derive(Debug, Clone, PartialEq)]
+enum AfterPutDown {
+    /// Retry the step from its lift keyframe.
+    Retry(usize),
+    /// Return to the driving posture and stop.
+    Recover(ExecFailure),
+}
+
+#[derive(Debug, Clone)]
+enum Mode {
+    Drive { follower: Box<PathFollower>, first: usize, last: usize },
+    Segment { from: Posture, index: usize, elapsed: f64, duration: f64, settle: f64 },
+    Guard { index: usize, wait: f64, attempts: usize, corr_from: [f64; 2] },
+    Confirm { index: usize, confirm: ContactConfirm },
+    PutDown { leg: Leg, lowered: f64, floor: f64, confirm: ContactConfirm, then: AfterPutDown },
+    Recover { from: Posture, to: Posture, elapsed: f64, duration: f64, failure: ExecFailure },
+    Finished,
+    Stopped(ExecFailure),
+}
+
+/// A step in progress: from the lift to the confirmed contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ActiveStep {
+    /// 1-based number of the step in the path.
+    pub number: usize,
+    /// The stepping leg.
+    pub leg: Leg,
+}
+
+/// Executes one detailed path (see the module docs).
+#[derive(Debug, Clone)]
+pub struct StepExecutor {
+    robot: RobotDescription,
+    config: ExecutorConfig,
+    keys: Vec<Keyframe>,
+    ground: HeightMap,
+    mode: Mode,
+    /// The last commanded posture (plan coordinates, without offsets or correction).
+    cmd: Posture,
+    /// Per-leg foot offsets (plan coordinates): landing corrections and extra lowering.
+    foot_offset: [[f64; 3]; 4],
+    /// Stabilising base correction (plan coordinates), m.
+    correction: [f64; 2],
+    /// The correction at the start of the segment that fades it out.
+    fading: Option<[f64; 2]>,
+    /// Foot offset of the stepping leg when its lift began (faded out during the lift).
+    lift_offset: [f64; 3],
+    /// Landing offset of the current step.
+    landing: [f64; 2],
+    last_legs: [[f64; 3]; 4],
+    /// Wheel angles the stance wheels hold (None: not holding), rad.
+    wheel_hold: [Option<[f64; 2]>; 4],
+    now: f64,
+    retries: usize,
+    steps_started: usize,
+    active: Option<ActiveStep>,
+    /// Steps whose placed foot was confirmed in contact.
+    pub steps_executed: usize,
+    /// Steps aborted before lifting (margin) or failed.
+    pub steps_aborted: usize,
+    /// What happened, in time order.
+    pub events: Vec<ExecEvent>,
+}
+
+impl StepExecutor {
+    /// An executor for `keys` (the keyframes of a detailed path, starting with its start
+    /// keyframe), with the height map `ground` for the return to the driving posture.
+    pub fn new(
+        robot: &RobotDescription,
+        config: ExecutorConfig,
+        keys: Vec<Keyframe>,
+        ground: HeightMap,
+    ) -> Self {
+        let cmd = keys.first().map_or(
+            Posture {
+                base_position: [0.0; 3],
+                base_rpy: [0.0; 3],
+                feet: [[0.0; 3]; 4],
+                contact: [true; 4],
+            },
+            Keyframe::posture,
+        );
+        let last_legs = keys.first().map_or([[0.0; 3]; 4], |k| k.joints);
+        let mut ex = Self {
+            robot: robot.clone(),
+            config,
+            keys,
+            ground,
+            mode: Mode::Finished,
+            cmd,
+            foot_offset: [[0.0; 3]; 4],
+            correction: [0.0; 2],
+            fading: None,
+            lift_offset: [0.0; 3],
+            landing: [0.0; 2],
+            last_legs,
+            wheel_hold: [None; 4],
+            now: 0.0,
+            retries: 0,
+            steps_started: 0,
+            active: None,
+            steps_executed: 0,
+            steps_aborted: 0,
+            events: Vec::new(),
+        };
+        ex.advance(1, 0.0);
+        ex
+    }
+
+    /// The step in progress (lift to confirmed contact), if any.
+    pub fn active_step(&self) -> Option<ActiveStep> {
+        self.active
+    }
+
+    /// Index of the keyframe being worked toward (the path's length when finished).
+    pub fn keyframe_index(&self) -> usize {
+        match &self.mode {
+            Mode::Drive { first, .. } => *first,
+            Mode::Segment { index, .. }
+            | Mode::Guard { index, .. }
+            | Mode::Confirm { index, .. } => *index,
+            _ => self.keys.len(),
+        }
+    }
+
+    /// The commanded planar base pose (plan coordinates, with the stabilising correction).
+    pub fn commanded_base(&self) -> Pose2 {
+        let p = self.with_offsets(&self.cmd);
+        planar(&p)
+    }
+
+    /// The phase of the keyframe being worked toward, if any.
+    pub fn phase(&self) -> Option<Phase> {
+        self.keys.get(self.keyframe_index()).map(|k| k.phase)
+    }
+
+    /// The commanded posture with the foot offsets and the correction applied.
+    fn with_offsets(&self, p: &Posture) -> Posture {
+        let mut q = *p;
+        q.base_position[0] += self.correction[0];
+        q.base_position[1] += self.correction[1];
+        q.base_rpy[0] += correction_roll(p, self.correction);
+        for (f, o) in q.feet.iter_mut().zip(self.foot_offset) {
+            for k in 0..3 {
+                f[k] += o[k];
+            }
+        }
+        q
+    }
+
+    fn event(&mut self, time: f64, event: ExecEventKind) {
+        self.events.push(ExecEvent { time_s: time, event });
+    }
+
+    /// Starts work toward keyframe `i`.
+    fn advance(&mut self, i: usize, time: f64) {
+        let Some(k) = self.keys.get(i) else {
+            self.mode = Mode::Finished;
+            return;
+        };
+        match k.phase {
+            Phase::Drive => {
+                let mut last = i;
+                while self.keys.get(last + 1).is_some_and(|k| k.phase == Phase::Drive) {
+                    last += 1;
+                }
+                let poses: Vec<Pose2> =
+                    self.keys[i - 1..=last].iter().map(|k| planar(&k.posture())).collect();
+                match PathFollower::new(poses, self.config.follower.clone()) {
+                    Ok(f) => {
+                        self.foot_offset = [[0.0; 3]; 4];
+                        self.correction = [0.0; 2];
+                        self.fading = None;
+                        self.mode = Mode::Drive { follower: Box::new(f), first: i, last };
+                    }
+                    Err(e) => self.fail(ExecFailure::Follower(e.to_string()), time),
+                }
+            }
+            Phase::Lift => {
+                self.retries = 0;
+                self.mode =
+                    Mode::Guard { index: i, wait: 0.0, attempts: 0, corr_from: self.correction };
+            }
+            _ => self.start_segment(i),
+        }
+    }
+
+    /// One control tick of `dt` s.
+    pub fn tick(&mut self, obs: &Observation, dt: f64) -> (Command, ExecStatus) {
+        let cmd = self.step_mode(obs, dt);
+        let status = match &self.mode {
+            Mode::Finished => ExecStatus::Finished,
+            Mode::Stopped(f) => ExecStatus::NeedsReplan(f.clone()),
+            _ => ExecStatus::Running,
+        };
+        (cmd, status)
+    }
+
+    fn step_mode(&mut self, obs: &Observation, dt: f64) -> Command {
+        let time = obs.time;
+        self.now = time;
+        let mode = std::mem::replace(&mut self.mode, Mode::Finished);
+        match mode {
+            Mode::Finished => {
+                self.mode = Mode::Finished;
+                self.hold()
+            }
+            Mode::Stopped(f) => {
+                self.mode = Mode::Stopped(f);
+                self.hold()
+            }
+            Mode::Drive { follower, first, last } => {
+                self.drive_tick(obs, dt, follower, first, last)
+            }
+            Mode::Segment { from, index, elapsed, duration, settle } => {
+                self.segment_tick(obs, dt, from, index, elapsed, duration, settle)
+            }
+            Mode::Guard { index, wait, attempts, corr_from } => {
+                self.guard_tick(obs, dt, index, wait, attempts, corr_from)
+            }
+            Mode::Confirm { index, confirm } => self.confirm_tick(obs, dt, index, confirm),
+            Mode::PutDown { leg, lowered, floor, confirm, then } => {
+                self.put_down_tick(obs, dt, leg, lowered, floor, confirm, then)
+            }
+            Mode::Recover { from, to, elapsed, duration, failure } => {
+                self.recover_tick(obs, dt, from, to, elapsed, duration, failure)
+            }
+        }
+    }
+
+    /// The lift keyframe of the step whose keyframe `index` is part of.
+    fn lift_index(&self, index: usize) -> usize {
+        (0..=index).rev().find(|&j| self.keys[j].phase == Phase::Lift).unwrap_or(index)
+    }
+
+    /// The place keyframe of the step lifting at `index`.
+    fn place_index(&self, index: usize) -> usize {
+        (index..self.keys.len()).find(|&j| self.keys[j].phase == Phase::Place).unwrap_or(index)
+    }
+}
