@@ -1,5 +1,5 @@
 //! Terrain as the planner sees it: the 2.5D [`HeightMap`] (2.5 cm cells, `NaN` = unknown)
-//! and its two sources, exact rasterisation of scenario primitives ([`rasterise`]) and
+//! and its two sources, exact rasterisation of scenario primitives ([`rasterise()`]) and
 //! ray-cast sensing like the robot's rotating laser ([`sensed`]).
 //!
 //! The cost maps (`cost`) are computed from a `HeightMap` and do not care which source
