@@ -188,10 +188,31 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
     // (The monitor's TipOver events mark the moments the margin was negative, which the
     // push causes by design; tilt and recovery time above are what "not tipping over"
     // means here.)
-    // The retry of the step may end the prefix (measured: the re-placed foot finds no
-    // contact within 10 cm of its foothold, and this prefix run has no replans); if so the
-    // run says so instead of going on.
+    // The foot is put down on the ground under it, here the floor before the platform
+    // edge: lower than both ends of the step. (Before, the put-down searched only down to
+    // the step's own grounds and failed with "no contact" 5 cm above the floor.)
+    let failures: Vec<&ExecFailure> = s
+        .executor_events
+        .iter()
+        .filter_map(|e| match &e.event {
+            ExecEventKind::Failure { failure } => Some(failure),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        !failures.iter().any(|f| matches!(f, ExecFailure::NoContact { .. })),
+        "{:#?}",
+        s.executor_events
+    );
+    // Then the step is retried from its lift: executed, or aborted by the lift guard
+    // because the push moved the robot off the support it had prepared (measured: margin
+    // −0.15 m after a 6 cm correction). A whole run then recovers and replans; this
+    // prefix run has no replans, so it must say why it stopped.
     if s.steps_executed < s.steps_planned {
+        assert!(
+            matches!(failures.as_slice(), [ExecFailure::StepAborted { leg: Leg::FrontLeft, .. }]),
+            "{failures:?}"
+        );
         assert!(s.failure.is_some(), "{s:#?}");
     }
 }

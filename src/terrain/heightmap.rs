@@ -322,12 +322,23 @@ impl HeightMap {
     /// `None` if none is known (or the point is off the map).
     #[inline]
     pub fn max_around(&self, x: f64, y: f64, r: usize) -> Option<f64> {
+        self.fold_around(x, y, r, f64::max)
+    }
+
+    /// Lowest known height over the (2r + 1)² cells around the cell containing (x, y),
+    /// `None` if none is known (or the point is off the map).
+    pub fn min_around(&self, x: f64, y: f64, r: usize) -> Option<f64> {
+        self.fold_around(x, y, r, f64::min)
+    }
+
+    #[inline]
+    fn fold_around(&self, x: f64, y: f64, r: usize, pick: fn(f64, f64) -> f64) -> Option<f64> {
         let (i, j) = self.cell_of(x, y)?;
         let mut best: Option<f64> = None;
         for jj in j.saturating_sub(r)..=(j + r).min(self.ny - 1) {
             for ii in i.saturating_sub(r)..=(i + r).min(self.nx - 1) {
                 if let Some(h) = self.get(ii, jj) {
-                    best = Some(best.map_or(h, |b: f64| b.max(h)));
+                    best = Some(best.map_or(h, |b| pick(b, h)));
                 }
             }
         }
@@ -508,6 +519,11 @@ mod tests {
         assert_eq!(d.get(1, 2), Some(32.0));
         assert_eq!(d.get(3, 3), Some(33.0));
         assert_eq!(hm.dilated_max(0), hm);
+        // (0.25, 0.15) lies in cell (2, 1): its 3 × 3 block holds 1..3, 11..13, 21..23.
+        assert_eq!(hm.max_around(0.25, 0.15, 1), Some(23.0));
+        assert_eq!(hm.min_around(0.25, 0.15, 1), Some(1.0));
+        assert_eq!(hm.min_around(0.05, 0.05, 0), Some(0.0));
+        assert_eq!(hm.min_around(5.0, 5.0, 1), None);
     }
 
     #[test]

@@ -55,13 +55,19 @@ impl StepExecutor {
         let p = self.with_offsets(&self.cmd);
         self.cmd.feet[i] = p.feet[i];
         self.foot_offset[i] = [0.0; 3];
-        // The lowest ground the foot was planned on, minus the extra lowering allowed.
+        // The lowest ground the foot was planned on or may stand over now (a foot put
+        // down mid-swing can be above lower ground than either end of its step, e.g. the
+        // floor before a platform edge), minus the extra lowering allowed.
+        let [x, y, _] = self.cmd.feet[i];
+        let half_width = self.robot.wheel_track / 2.0 + self.robot.wheel_radius;
+        let cells = (half_width / self.ground.resolution()).ceil() as usize;
+        let under = self.ground.min_around(x, y, cells).unwrap_or(f64::INFINITY);
         let floor = self
             .keys
             .iter()
             .filter(|k| k.leg == Some(leg))
             .map(|k| k.feet[i][2])
-            .fold(self.cmd.feet[i][2], f64::min)
+            .fold(self.cmd.feet[i][2].min(under), f64::min)
             - self.config.contact.max_extra_m;
         self.mode = Mode::PutDown {
             leg,
