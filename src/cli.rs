@@ -202,6 +202,9 @@ pub enum BenchCommand {
         /// Time budget of the A* run that finds the optimum, s.
         #[arg(long, default_value_t = 120.0)]
         optimum_limit: f64,
+        /// Runs of each search; times are their medians.
+        #[arg(long, default_value_t = 1)]
+        repeats: usize,
         /// Print the result as JSON.
         #[arg(long)]
         json: bool,
@@ -585,6 +588,7 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             scenario,
             arastar_limit,
             optimum_limit,
+            repeats,
             json,
             model,
         }) => {
@@ -592,6 +596,7 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             let opts = jobs::plan::BenchOptions {
                 arastar_time_limit_s: arastar_limit,
                 optimum_time_limit_s: optimum_limit,
+                repeats,
                 ..Default::default()
             };
             let report =
@@ -603,7 +608,12 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 let ms =
                     |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{:.1} ms", v * 1e3));
                 let c = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.3}"));
-                say!("scenario {} (setup {:.1} ms)", report.scenario, report.setup_time_s * 1e3);
+                say!(
+                    "scenario {} (setup {:.1} ms; times are medians of {})",
+                    report.scenario,
+                    report.setup_time_s * 1e3,
+                    opts.repeats
+                );
                 say!(
                     "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12} {:>10} {:>10}",
                     "algo",

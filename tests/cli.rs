@@ -148,6 +148,10 @@ fn bad_planner_option_names_the_parameter() {
             "{bad}: {stderr}"
         );
     }
+    let out = momaro(&["bench", "plan", scenario.to_str().unwrap(), "--repeats", "0"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("repeats") && !stderr.contains("panicked"), "{stderr}");
 }
 
 #[test]

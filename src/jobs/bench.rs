@@ -34,9 +34,22 @@ pub struct SimBench {
     pub repeats: usize,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+/// The median of `v` (the upper one of an even count); `v` must not be empty.
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
+}
+
+/// The median of `v` with `None` counted as larger than every value (a run that found
+/// no solution in time); `None` if that is where the median falls or `v` is empty.
+pub(crate) fn median_option(mut v: Vec<Option<f64>>) -> Option<f64> {
+    v.sort_by(|a, b| match (a, b) {
+        (Some(x), Some(y)) => x.total_cmp(y),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => std::cmp::Ordering::Equal,
+    });
+    v.get(v.len() / 2).copied().flatten()
 }
 
 /// Runs the benchmark: `repeats` alternating bare and controlled runs of `duration_s`.

@@ -626,11 +626,13 @@ pub struct BenchOptions {
     pub optimum_time_limit_s: f64,
     /// k12; default the scenario's.
     pub k12: Option<f64>,
+    /// Runs of each search; times (and the costs reached by a time) are their medians.
+    pub repeats: usize,
 }
 
 impl Default for BenchOptions {
     fn default() -> Self {
-        Self { arastar_time_limit_s: 15.0, optimum_time_limit_s: 300.0, k12: None }
+        Self { arastar_time_limit_s: 15.0, optimum_time_limit_s: 300.0, k12: None, repeats: 1 }
     }
 }
 
@@ -667,8 +669,46 @@ pub struct BenchRow {
     /// Time to build the graph's heuristic (the step bound), s: spent before the search
     /// starts, so not in any of the search times above.
     pub heuristic_setup_s: f64,
-    /// `(time_s, cost)` of every solution.
+    /// `(time_s, cost)` of every solution (of the run with the median first-solution
+    /// time).
     pub solutions: Vec<(f64, f64)>,
+    /// Runs the times are medians of.
+    pub repeats: usize,
+}
+
+impl BenchRow {
+    /// The row of medians over `runs` of the same search: every time, rate and
+    /// time-dependent cost is the median of the runs (see `bench::median_option`); what
+    /// does not depend on time (optimum, first cost, expansions) is the same in every run
+    /// of a deterministic search and is taken from the run with the median first-solution
+    /// time, with its solution list. `None` if `runs` is empty.
+    fn median_of(mut runs: Vec<BenchRow>) -> Option<BenchRow> {
+        use super::bench::{median, median_option};
+        let n = runs.len();
+        let opt = |f: fn(&BenchRow) -> Option<f64>| median_option(runs.iter().map(f).collect());
+        let val = |f: fn(&BenchRow) -> f64| median(runs.iter().map(f).collect());
+        if n == 0 {
+            return None;
+        }
+        let first_solution_s = opt(|r| r.first_solution_s);
+        let time_to_optimum_s = opt(|r| r.time_to_optimum_s);
+        let cost_at_1s = opt(|r| r.cost_at_1s);
+        let cost_at_10s = opt(|r| r.cost_at_10s);
+        let optimum_search_time_s = val(|r| r.optimum_search_time_s);
+        let expansions_per_s = val(|r| r.expansions_per_s);
+        let heuristic_setup_s = val(|r| r.heuristic_setup_s);
+        let k = runs.iter().position(|r| r.first_solution_s == first_solution_s).unwrap_or(0);
+        let mut row = runs.swap_remove(k);
+        row.first_solution_s = first_solution_s;
+        row.time_to_optimum_s = time_to_optimum_s;
+        row.cost_at_1s = cost_at_1s;
+        row.cost_at_10s = cost_at_10s;
+        row.optimum_search_time_s = optimum_search_time_s;
+        row.expansions_per_s = expansions_per_s;
+        row.heuristic_setup_s = heuristic_setup_s;
+        row.repeats = n;
+        Some(row)
+    }
 }
 
 /// A benchmark of one scenario.
@@ -714,12 +754,20 @@ pub fn bench(
                 .map(|r| (r, setup))
                 .map_err(|source| PlanJobError::Search { scenario: file(), source })
         };
-    let mut rows = Vec::new();
-    let (astar16, setup16) = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit)?;
-    rows.push(row("astar", "n16", &astar16, optimum_of(&astar16), &astar16, setup16));
-    let (astar20, _) = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit)?;
-    let (ara, setup20) = run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit)?;
-    rows.push(row("arastar", "n20", &ara, optimum_of(&astar20), &astar20, setup20));
+    if opts.repeats == 0 {
+        return Err(bad("repeats", "0 must be at least 1"));
+    }
+    // The repeats alternate the three searches, so slow phases of a noisy machine spread
+    // over all of them.
+    let (mut astar_runs, mut ara_runs) = (Vec::new(), Vec::new());
+    for _ in 0..opts.repeats {
+        let (astar16, setup16) = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit)?;
+        astar_runs.push(row("astar", "n16", &astar16, optimum_of(&astar16), &astar16, setup16));
+        let (astar20, _) = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit)?;
+        let (ara, setup20) = run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit)?;
+        ara_runs.push(row("arastar", "n20", &ara, optimum_of(&astar20), &astar20, setup20));
+    }
+    let rows = [astar_runs, ara_runs].into_iter().filter_map(BenchRow::median_of).collect();
     Ok(BenchReport { scenario: scenario.name.clone(), setup_time_s: prep.setup_time_s, rows })
 }
 
@@ -761,5 +809,52 @@ fn row(
         expansions_per_s: r.expansions as f64 / r.elapsed.as_secs_f64().max(1e-9),
         heuristic_setup_s,
         solutions: sols,
+        repeats: 1,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::BenchRow;
+
+    fn run(first: f64, to_optimum: Option<f64>, at_1s: Option<f64>, rate: f64) -> BenchRow {
+        BenchRow {
+            algorithm: "arastar",
+            neighbourhood: "n20",
+            optimum: Some(78.0),
+            optimum_search_time_s: 2.0 * first,
+            first_solution_s: Some(first),
+            first_cost: Some(80.0),
+            first_over_optimum_pct: Some(2.5),
+            cost_at_1s: at_1s,
+            cost_at_10s: Some(79.0),
+            time_to_optimum_s: to_optimum,
+            first_expansions: Some(400),
+            expansions: 1000,
+            expansions_per_s: rate,
+            heuristic_setup_s: 0.01,
+            solutions: vec![(first, 80.0)],
+            repeats: 1,
+        }
+    }
+
+    #[test]
+    fn bench_rows_take_the_median_of_each_time() {
+        let m = BenchRow::median_of(vec![
+            run(3.0, Some(10.0), None, 100.0),
+            run(1.0, None, None, 300.0),
+            run(2.0, Some(5.0), Some(80.0), 200.0),
+        ])
+        .expect("three runs");
+        // First solutions 1, 2, 3 s: 2 s, and that run's solution list.
+        assert_eq!(m.first_solution_s, Some(2.0));
+        assert_eq!(m.solutions, vec![(2.0, 80.0)]);
+        // To the optimum 5, 10 and never: 10 s. A cost at 1 s in one run of three: none.
+        assert_eq!(m.time_to_optimum_s, Some(10.0));
+        assert_eq!(m.cost_at_1s, None);
+        assert_eq!(m.optimum_search_time_s, 4.0);
+        assert_eq!(m.expansions_per_s, 200.0);
+        assert_eq!(m.repeats, 3);
+        assert_eq!(BenchRow::median_of(Vec::new()), None);
     }
 }
