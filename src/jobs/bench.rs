@@ -1,5 +1,8 @@
 //! `momaro bench`: speed measurements that are not assertions.
 //!
+//! The medians here (`median`, `median_option`) also serve `bench plan`
+//! (`jobs::plan::bench`), whose times are medians over its repeats.
+//!
 //! `bench sim` runs a scenario's world twice for the same simulated time: once as a bare
 //! `mj_step` loop with the actuator targets of the standing posture fixed (the physics
 //! limit), once as `momaro sim` runs it (controller and stability monitor every control
@@ -34,10 +37,10 @@ pub struct SimBench {
     pub repeats: usize,
 }
 
-/// The median of `v` (the upper one of an even count); `v` must not be empty.
+/// The median of `v` (the upper one of an even count); NaN if `v` is empty.
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// The median of `v` with `None` counted as larger than every value (a run that found

@@ -71,7 +71,7 @@ impl StandingRule {
         a: [f64; 3],
         b: [f64; 3],
     ) -> f64 {
-        let radius = robot.wheel_radius + robot.wheel_track / 2.0 + 0.02;
+        let radius = robot.wheel_pair_radius() + 0.02;
         heights.max_height_near_segment(a, b, radius) + self.swing_clearance_m
     }
 
@@ -202,8 +202,8 @@ impl StandingRule {
         let mut variants = vec![pre, post];
         let mut probes: Vec<ReachProbe> = variants.iter().map(probe).collect();
         // The swing height scans the terrain around the path, the dearest part: only
-        // when both ground stances pass the distance check at some height (the planner
-        // rejects most candidate footholds right here).
+        // when both ground stances pass the distance check at some height (a quarter of
+        // the planner's candidate footholds on the platform end here).
         let grounded = self.heights().any(|h| probes.iter().all(|p| p.distances_ok(h).is_ok()));
         if grounded {
             let swing_z = self.swing_z(robot, heights, pre[leg], post_foot);
@@ -225,7 +225,8 @@ impl StandingRule {
         // first at the next height: mostly the same one fails (the foot lifted at one end
         // of its swing folds the leg past a joint limit), so a rejected height costs one
         // IK instead of several.
-        self.heights().take(if grounded { usize::MAX } else { 0 }).filter(move |&h| {
+        let tried = if grounded { Some(self.heights()) } else { None };
+        tried.into_iter().flatten().filter(move |&h| {
             if !probes.iter().all(|p| p.distances_ok(h).is_ok()) {
                 return false;
             }

@@ -152,6 +152,12 @@ impl RobotDescription {
         self.thigh_length + self.shin_length + self.foot_length + self.wheel_radius
     }
 
+    /// Radius around a foot that covers its wheel pair in every direction (half the
+    /// track plus a wheel radius), m.
+    pub fn wheel_pair_radius(&self) -> f64 {
+        self.wheel_track / 2.0 + self.wheel_radius
+    }
+
     /// x' offsets of the centres of the two circles that approximate the base (Sec. IV),
     /// for circles of radius `radius` inscribed at the two ends of the base box.
     pub fn base_circle_centres_x(&self, radius: f64) -> [f64; 2] {

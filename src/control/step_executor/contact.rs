@@ -57,10 +57,10 @@ impl StepExecutor {
         self.foot_offset[i] = [0.0; 3];
         // The lowest ground the foot was planned on or may stand over now (a foot put
         // down mid-swing can be above lower ground than either end of its step, e.g. the
-        // floor before a platform edge), minus the extra lowering allowed.
+        // floor before a platform edge), minus the extra lowering allowed. Over a ditch
+        // this is its bottom: contact or the leg's reach stops the foot first.
         let [x, y, _] = self.cmd.feet[i];
-        let half_width = self.robot.wheel_track / 2.0 + self.robot.wheel_radius;
-        let cells = (half_width / self.ground.resolution()).ceil() as usize;
+        let cells = (self.robot.wheel_pair_radius() / self.ground.resolution()).ceil() as usize;
         let under = self.ground.min_around(x, y, cells).unwrap_or(f64::INFINITY);
         let floor = self
             .keys

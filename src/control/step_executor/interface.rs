@@ -172,8 +172,9 @@ pub enum ExecFailure {
         /// Required margin, m.
         required_m: f64,
     },
-    /// A foot found no contact within the extra lowering.
-    #[error("step of {leg:?} failed: no contact {extra_m:.3} m below the foothold")]
+    /// A foot found no contact within the extra lowering (after placing: below the
+    /// foothold; when put down: below where it was put down from).
+    #[error("step of {leg:?} failed: no contact after lowering the foot {extra_m:.3} m")]
     NoContact {
         /// The leg.
         leg: Leg,

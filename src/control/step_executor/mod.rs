@@ -148,7 +148,8 @@ pub struct StepExecutor {
 
 impl StepExecutor {
     /// An executor for `keys` (the keyframes of a detailed path, starting with its start
-    /// keyframe), with the height map `ground` for the return to the driving posture.
+    /// keyframe), with the height map `ground` for the return to the driving posture and
+    /// for how low a foot put down in an emergency may go.
     pub fn new(
         robot: &RobotDescription,
         config: ExecutorConfig,
