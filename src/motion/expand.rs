@@ -51,7 +51,7 @@ use super::keyframe::{DetailedPath, Keyframe, Phase};
 use super::kinematics;
 use super::kinematics::{Evaluation, Posture, contacts_in_base, evaluate, interpolate, rotation};
 use super::roll::roll_for_lateral_com;
-use super::standing::{StandingRule, base_z};
+use super::standing::{StandingRule, StepStance, base_z};
 use crate::cost::CostMaps;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::jobs::plan::{PathElement, PathKind};
@@ -428,11 +428,13 @@ impl Expander<'_> {
         [self.cur.base_position[0], self.cur.base_position[1]]
     }
 
-    /// Builds the keyframes of one step candidate.
+    /// Builds the keyframes of one step candidate, the foot carried at `swing_z`.
+    #[allow(clippy::too_many_arguments)]
     fn step_candidate(
         &mut self,
         leg: Leg,
         post_foot: [f64; 3],
+        swing_z: f64,
         height: f64,
         wheel_fraction: f64,
         roll_fraction: f64,
@@ -446,12 +448,9 @@ impl Expander<'_> {
         let along = |f: [f64; 3]| c * f[0] + s * f[1];
         let lateral = |f: [f64; 3]| -s * f[0] + c * f[1];
         let pre = self.cur.feet;
-        let mut post = pre;
-        post[i] = post_foot;
-        let pitch = self.o.standing.step_pitch(&pre, &post, yaw);
+        let StepStance { post, pitch, ground } =
+            self.o.standing.step_stance(&pre, i, post_foot, yaw);
         let pitch_post = self.pitch_for(&post, yaw);
-        let mut ground = pre.map(|f| f[2]);
-        ground[i] = pre[i][2].max(post_foot[2]);
         let xy = self.xy();
         let all = [true; 4];
         let mut lifted = all;
@@ -552,8 +551,6 @@ impl Expander<'_> {
         };
         let xy_shift = [xy[0] + shift * c, xy[1] + shift * s];
 
-        // Swing height.
-        let swing_z = self.o.standing.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
         let mut lift_feet = moved;
         lift_feet[i] = [pre[i][0], pre[i][1], swing_z];
         let mut swing_feet = moved;
@@ -613,6 +610,8 @@ impl Expander<'_> {
             )
             .collect::<Vec<_>>();
         heights.extend([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1]);
+        // The same for every candidate (what `step_heights` checked the swing at).
+        let swing_z = rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
         // First the paper's sequence (a base shift only where the wheel was hindered), in
         // full, half or none of each alignment; then base shifts of fixed length with
         // every wheel and roll choice (the CoM may need to go where the wheel cannot
@@ -638,7 +637,7 @@ impl Expander<'_> {
         }
         let mut best: (f64, String) = (f64::NEG_INFINITY, "no candidate".to_owned());
         for (h, wf, rf, shift) in candidates {
-            let seq = match self.step_candidate(leg, post_foot, h, wf, rf, shift) {
+            let seq = match self.step_candidate(leg, post_foot, swing_z, h, wf, rf, shift) {
                 Ok(s) => s,
                 Err(e) => {
                     if best.0 == f64::NEG_INFINITY {

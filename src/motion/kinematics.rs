@@ -10,7 +10,7 @@
 
 use super::CenterOfMassModel;
 use crate::geometry::Pose2;
-use crate::robot::ik::{IkError, leg_ik};
+use crate::robot::ik::{IkError, ankle_of_contact, leg_ik};
 use crate::robot::{Leg, RobotDescription};
 use crate::stability::{convex_hull, stability_margin};
 use serde::Serialize;
@@ -146,7 +146,6 @@ pub fn solve_legs(
 ) -> Result<[[f64; 3]; 4], PostureError> {
     let local = contacts_in_base(robot, p);
     let pitch = p.base_rpy[1];
-    let below = robot.foot_length + robot.wheel_radius;
     let reach = robot.thigh_length + robot.shin_length;
     let mut joints = [[0.0; 3]; 4];
     for leg in Leg::ALL {
@@ -155,8 +154,7 @@ pub fn solve_legs(
         if p.contact[i] && c[1].abs() > MAX_LATERAL_MISMATCH_M {
             return Err(PostureError::Lateral { leg, offset: c[1] });
         }
-        // Ankle position as leg_ik computes it: the foot segment along world down.
-        let ankle = [c[0] + below * (-pitch).sin(), c[2] + below * (-pitch).cos()];
+        let ankle = ankle_of_contact(robot, [c[0], c[2]], pitch);
         let distance = ankle[0].hypot(ankle[1]);
         if distance > reach - reach_margin {
             return Err(PostureError::ReachMargin { leg, distance, margin: reach_margin });

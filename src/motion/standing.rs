@@ -23,7 +23,7 @@ use super::kinematics::{Posture, PostureError, apply, pitch_from_feet, rotation,
 use crate::geometry::Pose2;
 use crate::params::Params;
 use crate::robot::RobotDescription;
-use crate::robot::ik::knee_and_ankle;
+use crate::robot::ik::{knee_and_ankle, world_down};
 use crate::terrain::HeightMap;
 
 /// The parameters of the rule.
@@ -85,8 +85,8 @@ impl StandingRule {
 
     /// Whether every thigh and shin of posture `p` (joint angles `joints`) keeps
     /// `leg_clearance_m` above `terrain` (heights dilated by the legs' width, see
-    /// `CostMaps::leg_terrain`) at points a quarter segment (6.25 cm) apart along it: a lowered base must not fold a
-    /// knee onto a step.
+    /// `CostMaps::leg_terrain`) at points a quarter segment (6.25 cm) apart along it: a
+    /// lowered base must not fold a knee onto a step.
     ///
     /// # Errors
     /// [`PostureError::LegCollision`] naming the leg and its clearance.
@@ -137,6 +137,24 @@ impl StandingRule {
         (self.pitch(pre, yaw) + self.pitch(post, yaw)) / 2.0
     }
 
+    /// The stance a step of leg `leg` from feet `pre` to `post_foot` is made in, under
+    /// heading `yaw`: the step's pitch ([`Self::step_pitch`]) and the ground under each
+    /// leg, the stepping leg counting the higher of its two grounds (the foot must clear
+    /// it). Planner and generator both stand a step this way.
+    pub fn step_stance(
+        &self,
+        pre: &[[f64; 3]; 4],
+        leg: usize,
+        post_foot: [f64; 3],
+        yaw: f64,
+    ) -> StepStance {
+        let mut post = *pre;
+        post[leg] = post_foot;
+        let mut ground = pre.map(|f| f[2]);
+        ground[leg] = pre[leg][2].max(post_foot[2]);
+        StepStance { post, pitch: self.step_pitch(pre, &post, yaw), ground }
+    }
+
     /// The first height of [`Self::heights`] at which all four feet (in contact, on their
     /// legs' planes) are reached and no thigh or shin touches `terrain`
     /// ([`Self::legs_clear`]), with the posture.
@@ -160,7 +178,6 @@ impl StandingRule {
                 last = Some(e);
                 continue;
             }
-
             let p = level_posture(robot, feet, [true; 4], xy, [0.0, pitch, yaw], h, ground);
             match solve_legs(robot, &p, self.reach_margin_m)
                 .and_then(|q| self.legs_clear(robot, terrain, &p, &q))
@@ -191,11 +208,7 @@ impl StandingRule {
         xy: [f64; 2],
         yaw: f64,
     ) -> impl Iterator<Item = f64> + use<'a> {
-        let mut post = pre;
-        post[leg] = post_foot;
-        let pitch = self.step_pitch(&pre, &post, yaw);
-        let mut ground = pre.map(|f| f[2]);
-        ground[leg] = pre[leg][2].max(post_foot[2]);
+        let StepStance { post, pitch, ground } = self.step_stance(&pre, leg, post_foot, yaw);
         let rpy = [0.0, pitch, yaw];
         let probe =
             |feet: &[[f64; 3]; 4]| ReachProbe::new(robot, feet, [true; 4], xy, rpy, &ground, self);
@@ -257,14 +270,21 @@ impl StandingRule {
         base: &Pose2,
         height: f64,
     ) -> Posture {
-        let mut post = pre;
-        post[leg] = post_foot;
-        let pitch = self.step_pitch(&pre, &post, base.theta);
-        let mut ground = pre.map(|f| f[2]);
-        ground[leg] = pre[leg][2].max(post_foot[2]);
+        let StepStance { pitch, ground, .. } = self.step_stance(&pre, leg, post_foot, base.theta);
         let xy = [base.x, base.y];
         level_posture(robot, pre, [true; 4], xy, [0.0, pitch, base.theta], height, ground)
     }
+}
+
+/// How a step is stood ([`StandingRule::step_stance`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepStance {
+    /// The feet after the step.
+    pub post: [[f64; 3]; 4],
+    /// Base pitch during the step, rad.
+    pub pitch: f64,
+    /// Ground height under each leg, the stepping leg's the higher of its two, m.
+    pub ground: [f64; 4],
 }
 
 /// Spacing of the swing points [`StandingRule::step_heights`] checks, m.
@@ -280,7 +300,8 @@ struct ReachProbe {
     /// Rᵀ·e_z: world up in the base frame.
     up: [f64; 3],
     h0: f64,
-    /// Ankle offset below the contact point in the base frame (x', z').
+    /// From the contact point to the ankle in the base frame (x', z'), as
+    /// [`crate::robot::ik::ankle_of_contact`] adds it.
     ankle: [f64; 2],
     limit: f64,
     reach_margin: f64,
@@ -301,11 +322,12 @@ impl ReachProbe {
         let p = level_posture(robot, *feet, contact, xy, rpy, h0, *ground);
         let r = rotation(rpy);
         let below = robot.foot_length + robot.wheel_radius;
+        let down = world_down(rpy[1]);
         Self {
             local0: super::kinematics::contacts_in_base(robot, &p),
             up: [r[2][0], r[2][1], r[2][2]],
             h0,
-            ankle: [below * (-rpy[1]).sin(), below * (-rpy[1]).cos()],
+            ankle: [-below * down[0], -below * down[1]],
             limit: robot.thigh_length + robot.shin_length - rule.reach_margin_m,
             reach_margin: rule.reach_margin_m,
             contact,
@@ -484,18 +506,12 @@ mod tests {
         // Front feet on a 0.2 m platform, rear feet under their hips on the floor; the
         // rear-left foot steps 0.3 m forward onto the platform.
         let pre = [[0.35, 0.32, 0.2], [0.35, -0.32, 0.2], [-0.35, 0.32, 0.0], [-0.35, -0.32, 0.0]];
-        let hs = r
-            .step_heights(
-                &robot,
-                &platform(),
-                &platform(),
-                pre,
-                2,
-                [-0.05, 0.32, 0.2],
-                [0.0, 0.0],
-                0.0,
-            )
-            .collect::<Vec<_>>();
+        let map = platform();
+        let heights_for = |feet| {
+            r.step_heights(&robot, &map, &map, feet, 2, [-0.05, 0.32, 0.2], [0.0, 0.0], 0.0)
+                .collect::<Vec<_>>()
+        };
+        let hs = heights_for(pre);
         assert!(!hs.is_empty());
         // Every height listed really reaches with the stepping leg over 0.2 m…
         let mut post = pre;
@@ -516,18 +532,7 @@ mod tests {
         // …and with the other rear foot 0.4 m behind its hip no height does.
         let mut stretched = pre;
         stretched[3][0] = -0.75;
-        let hs = r
-            .step_heights(
-                &robot,
-                &platform(),
-                &platform(),
-                stretched,
-                2,
-                [-0.05, 0.32, 0.2],
-                [0.0, 0.0],
-                0.0,
-            )
-            .collect::<Vec<_>>();
+        let hs = heights_for(stretched);
         assert!(hs.is_empty(), "{hs:?}");
     }
 

@@ -47,6 +47,21 @@ fn u(a: f64) -> [f64; 2] {
     [-a.sin(), -a.cos()]
 }
 
+/// World down in the base frame of a base pitched by `pitch`, (x', z'): the direction of
+/// a level wheel's foot segment, and of its ground contact point from the axle.
+pub fn world_down(pitch: f64) -> [f64; 2] {
+    u(-pitch)
+}
+
+/// The ankle (x', z') relative to the hip for the wheel's ground contact point at
+/// `contact`, in the base frame of a base pitched by `pitch`, the wheel level: the foot
+/// segment and wheel radius straight up from the contact along [`world_down`].
+pub fn ankle_of_contact(robot: &RobotDescription, contact: [f64; 2], pitch: f64) -> [f64; 2] {
+    let down = world_down(pitch);
+    let below = robot.foot_length + robot.wheel_radius;
+    [contact[0] - below * down[0], contact[1] - below * down[1]]
+}
+
 /// Joint angles (hip, knee, ankle) that put the wheel's ground contact point at `contact`
 /// = (x', z') relative to the hip, in the base frame of a base pitched by `pitch` (rad,
 /// positive nose down), with the wheel level in the world.
@@ -63,11 +78,7 @@ pub fn leg_ik(
         return Err(IkError::NotFinite { leg });
     }
     let (l1, l2) = (robot.thigh_length, robot.shin_length);
-    // World "down" in the base frame: the direction of the foot segment and of the contact
-    // point from the axle.
-    let down = u(-pitch);
-    let below = robot.foot_length + robot.wheel_radius;
-    let ankle = [contact[0] - below * down[0], contact[1] - below * down[1]];
+    let ankle = ankle_of_contact(robot, contact, pitch);
     let d2 = ankle[0] * ankle[0] + ankle[1] * ankle[1];
     let d = d2.sqrt();
     if d > l1 + l2 || d < (l1 - l2).abs() {

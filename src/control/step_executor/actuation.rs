@@ -6,7 +6,7 @@
 use super::{Command, ExecFailure, Observation, StepExecutor};
 use crate::control::wheels::WheelPairCommand;
 use crate::motion::kinematics::{Posture, contacts_in_base};
-use crate::robot::ik::{IkError, leg_ik};
+use crate::robot::ik::{IkError, ankle_of_contact, leg_ik, world_down};
 use crate::robot::{Leg, RobotDescription};
 
 /// Wheel speed (rad/s) that rolls a pair steered straight along a base heading `yaw` at
@@ -35,13 +35,12 @@ pub fn reachable_leg_targets(
     let pitch = p.base_rpy[1];
     let below = robot.foot_length + robot.wheel_radius;
     let reach = robot.thigh_length + robot.shin_length - spare;
-    // World down in the base frame (the foot segment's direction), as `leg_ik` uses it.
-    let down = [pitch.sin(), -pitch.cos()];
+    let down = world_down(pitch);
     let mut q = [[0.0; 3]; 4];
     for leg in Leg::ALL {
         let c = local[leg.index()];
         let mut contact = [c[0], c[2]];
-        let ankle = [contact[0] - below * down[0], contact[1] - below * down[1]];
+        let ankle = ankle_of_contact(robot, contact, pitch);
         let d = ankle[0].hypot(ankle[1]);
         if d > reach {
             let k = reach / d;
