@@ -284,6 +284,20 @@ fn run_error(e: jobs::run::RunJobError) -> anyhow::Error {
     }
 }
 
+/// The JSON of a run that ended in an error rather than a summary: `run --json` always
+/// prints one object, with the failure's kind (`invalid_input` or `error`).
+fn error_summary(scenario: &std::path::Path, e: &anyhow::Error) -> serde_json::Value {
+    let kind = if e.chain().any(|c| c.is::<BadInput>()) { "invalid_input" } else { "error" };
+    serde_json::json!({
+        "scenario": scenario.file_stem().map(|s| s.to_string_lossy().into_owned()),
+        "path": scenario.display().to_string(),
+        "passed": false,
+        "reached_goal": false,
+        "failure_kind": kind,
+        "failure": format!("{e:#}"),
+    })
+}
+
 fn robot(model: &std::path::Path) -> anyhow::Result<crate::robot::RobotDescription> {
     Ok(crate::sim::Simulation::robot_only(model)?.robot().clone())
 }
@@ -476,14 +490,22 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             Ok(true)
         }
         Command::Run { scenario, planner, noise, rerun, json, model } => {
-            let sc = load(&scenario)?;
             let opts = jobs::run::RunOptions {
                 rerun,
                 progress: !json,
                 noise,
                 ..jobs::run::RunOptions::new(planner.options(), model.model)
             };
-            let s = jobs::run::run(&sc, &opts).map_err(run_error)?;
+            let s = match load(&scenario).and_then(|sc| jobs::run::run(&sc, &opts).map_err(run_error))
+            {
+                Ok(s) => s,
+                Err(e) => {
+                    if json {
+                        print_json(&error_summary(&scenario, &e))?;
+                    }
+                    return Err(e);
+                }
+            };
             if json {
                 print_json(&s)?;
             } else {
@@ -510,6 +532,13 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 );
                 if let Some(f) = &s.failure {
                     say!("stopped             {f}");
+                }
+                if s.static_violation_s > 0.0 {
+                    say!(
+                        "static violations   {:.3} s, worst {:.3} m",
+                        s.static_violation_s,
+                        s.worst_static_violation_m
+                    );
                 }
                 say!(
                     "tracking error      max {:.3} m, mean {:.3} m",

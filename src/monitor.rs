@@ -1,7 +1,27 @@
 //! The stability monitor: each control step it takes the robot's CoM as MuJoCo computes it
-//! and the wheels MuJoCo reports in terrain contact, and measures the static stability
-//! margin (see `stability`), tilt and body-terrain collisions. It keeps minima and a list of
-//! events for the run's summary.
+//! and the wheels MuJoCo reports at the terrain, and tells apart three things that an
+//! earlier monitor lumped together as "tip-over":
+//!
+//! - a **static-stability violation**: the CoM's ground projection lies outside the
+//!   support polygon of the *supporting* wheels (see `stability`). Its total duration and
+//!   worst margin are kept; a scenario bounds the duration
+//!   (`expect.max_static_violation_s`).
+//! - a **tip-over**: the robot really falls: the base tilts past
+//!   [`MonitorLimits::max_tilt_rad`], the trunk (the `base` body: lower body, torso, head)
+//!   touches the terrain, or the base drops faster than [`MonitorLimits::fall_speed_m_s`].
+//!   Only this sets `tipped`.
+//! - **contact events**: fewer wheels supporting than expected, and robot links other
+//!   than wheels touching terrain (a shin brushing a stair nosing is a collision, not a
+//!   fall).
+//!
+//! **Supporting wheels.** A wheel supports the robot when MuJoCo places it within
+//! [`MonitorLimits::support_gap_m`] of the terrain (the foam wheel compresses by more than
+//! that under load, so a wheel this close carries weight as soon as the robot leans onto
+//! it), or when it touched the terrain (within 1 mm) during the last
+//! [`MonitorLimits::support_memory_s`] (a wheel bouncing off a bump edge for a few
+//! milliseconds still holds the robot up: static stability is about where the robot can
+//! rest, and it rests on that wheel again before it can rotate measurably). Its support
+//! point is where it last touched.
 
 use crate::sim::Simulation;
 use crate::stability::{convex_hull, stability_margin};
@@ -14,7 +34,7 @@ pub struct StabilitySample {
     pub time: f64,
     /// Whole-robot CoM, m.
     pub com: [f64; 3],
-    /// Horizontal positions of the wheels in contact.
+    /// Horizontal positions of the supporting wheels.
     pub contacts: Vec<[f64; 2]>,
     /// Support polygon (convex hull of the contacts), counter-clockwise.
     pub support_polygon: Vec<[f64; 2]>,
@@ -22,20 +42,53 @@ pub struct StabilitySample {
     pub margin: f64,
     /// Base roll and pitch, rad.
     pub roll_pitch: [f64; 2],
+    /// Vertical speed of the base, m/s.
+    pub vertical_speed: f64,
     /// Robot bodies other than wheels touching terrain.
     pub body_collisions: Vec<String>,
+}
+
+impl StabilitySample {
+    /// Largest of |roll| and |pitch|, rad.
+    pub fn tilt(&self) -> f64 {
+        self.roll_pitch[0].abs().max(self.roll_pitch[1].abs())
+    }
+}
+
+/// Why the monitor judged a tip-over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TipCause {
+    /// Roll or pitch past the limit.
+    Tilt,
+    /// The trunk touched the terrain.
+    TrunkContact,
+    /// The base fell.
+    Fall,
 }
 
 /// Something the monitor flags.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum MonitorEvent {
-    /// The CoM left the support polygon or the base tilted past the limit.
+    /// The robot fell over.
     TipOver {
         /// Simulated time, s.
         time_s: f64,
-        /// Margin at that time, m.
-        margin_m: f64,
+        /// What showed it.
+        cause: TipCause,
+        /// Tilt at that time, degrees.
+        tilt_deg: f64,
+    },
+    /// The CoM left the support polygon of the supporting wheels (reported when it
+    /// returns, or at the end of the run).
+    StaticViolation {
+        /// When it started, s.
+        start_s: f64,
+        /// How long it lasted, s.
+        duration_s: f64,
+        /// Most negative margin, m.
+        worst_margin_m: f64,
     },
     /// A robot body other than a wheel touched terrain.
     BodyCollision {
@@ -44,11 +97,11 @@ pub enum MonitorEvent {
         /// The body.
         body: String,
     },
-    /// Fewer wheels touched the ground than expected.
+    /// Fewer wheels supported the robot than expected.
     ContactLost {
         /// Simulated time, s.
         time_s: f64,
-        /// Wheels in contact.
+        /// Wheels supporting.
         wheels: usize,
     },
 }
@@ -56,16 +109,45 @@ pub enum MonitorEvent {
 /// Limits the monitor checks against.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MonitorLimits {
-    /// Roll or pitch beyond this counts as tipping, rad.
+    /// Roll or pitch beyond this is a tip-over, rad: steps pitch the base by at most about
+    /// 15°, so 35° is a robot falling, not climbing.
     pub max_tilt_rad: f64,
-    /// Wheels expected on the ground (8 while driving).
+    /// A base sinking faster than this is falling, m/s: the slowest joint motion the
+    /// controllers command lowers it at about 0.1 m/s.
+    pub fall_speed_m_s: f64,
+    /// A wheel this close to the terrain supports the robot, m: the wheels' contact gap
+    /// in the model, within the foam's compression under load.
+    pub support_gap_m: f64,
+    /// A wheel that touched the terrain this recently still supports the robot, s.
+    pub support_memory_s: f64,
+    /// Wheels expected to support the robot (8 while driving).
     pub expected_wheels: usize,
+    /// Samples before this time only update the wheel memory (the robot settles), s.
+    pub settle_s: f64,
 }
 
 impl Default for MonitorLimits {
     fn default() -> Self {
-        Self { max_tilt_rad: 35f64.to_radians(), expected_wheels: 8 }
+        Self {
+            max_tilt_rad: 35f64.to_radians(),
+            fall_speed_m_s: 0.5,
+            support_gap_m: 0.004,
+            support_memory_s: 0.03,
+            expected_wheels: 8,
+            settle_s: 0.0,
+        }
     }
+}
+
+/// The body whose contact with terrain is a fall (the MJCF's root body: lower body,
+/// torso, head).
+pub const TRUNK_BODY: &str = "base";
+
+/// A static-stability violation under way.
+#[derive(Debug, Clone, Copy)]
+struct OpenViolation {
+    start: f64,
+    worst: f64,
 }
 
 /// Accumulates samples over a run.
@@ -74,12 +156,20 @@ pub struct StabilityMonitor {
     limits: MonitorLimits,
     /// Smallest margin seen, m.
     pub min_margin: f64,
-    /// Fewest wheels in contact seen.
+    /// Fewest supporting wheels seen.
     pub min_wheels: usize,
     /// Largest |roll| or |pitch| seen, rad.
     pub max_tilt: f64,
+    /// Total time the CoM was outside the support, s.
+    pub static_violation_s: f64,
+    /// Most negative margin of any violation, m (0 if none).
+    pub worst_violation_m: f64,
     /// Events, in time order; each kind is reported again only after it cleared.
     pub events: Vec<MonitorEvent>,
+    /// Per wheel (leg-major): last time it touched and where.
+    last_touch: [Option<(f64, [f64; 2])>; 8],
+    last_time: Option<f64>,
+    violation: Option<OpenViolation>,
     tipped: bool,
     contact_lost: bool,
     colliding: Vec<String>,
@@ -93,48 +183,128 @@ impl StabilityMonitor {
             min_margin: f64::INFINITY,
             min_wheels: usize::MAX,
             max_tilt: 0.0,
+            static_violation_s: 0.0,
+            worst_violation_m: 0.0,
             events: Vec::new(),
+            last_touch: [None; 8],
+            last_time: None,
+            violation: None,
             tipped: false,
             contact_lost: false,
             colliding: Vec::new(),
         }
     }
 
-    /// Measures the simulation's current state without recording it.
-    pub fn measure(sim: &Simulation) -> StabilitySample {
-        let com = sim.center_of_mass();
-        let contacts: Vec<[f64; 2]> =
-            sim.wheel_contacts().iter().map(|c| [c.position[0], c.position[1]]).collect();
-        let rpy = sim.base().rpy;
+    /// Measures the simulation's current state, updates the wheel memory and, after
+    /// settling, records the sample.
+    pub fn observe(&mut self, sim: &Simulation) -> StabilitySample {
+        let base = sim.base();
+        let wheels: Vec<WheelReading> = sim
+            .wheel_contacts()
+            .iter()
+            .map(|c| WheelReading {
+                index: c.leg.index() * 2 + c.wheel,
+                position: [c.position[0], c.position[1]],
+                distance: c.distance,
+            })
+            .collect();
+        let s = self.sample(
+            sim.time(),
+            sim.center_of_mass(),
+            &wheels,
+            [base.rpy[0], base.rpy[1]],
+            base.linear_velocity[2],
+            sim.body_terrain_collisions(),
+        );
+        if s.time >= self.limits.settle_s {
+            self.record(&s);
+        }
+        s
+    }
+
+    /// The sample for wheel readings `wheels` at `time`, updating the wheel memory.
+    fn sample(
+        &mut self,
+        time: f64,
+        com: [f64; 3],
+        wheels: &[WheelReading],
+        roll_pitch: [f64; 2],
+        vertical_speed: f64,
+        body_collisions: Vec<String>,
+    ) -> StabilitySample {
+        let mut near = [None; 8];
+        for w in wheels {
+            if w.distance <= crate::sim::TOUCHING_M {
+                self.last_touch[w.index] = Some((time, w.position));
+            }
+            if w.distance <= self.limits.support_gap_m {
+                near[w.index] = Some(w.position);
+            }
+        }
+        let memory = self.limits.support_memory_s + 1e-9;
+        let contacts: Vec<[f64; 2]> = (0..8)
+            .filter_map(|k| {
+                near[k].or(self.last_touch[k]
+                    .filter(|(t, _)| time - t <= memory)
+                    .map(|(_, p)| p))
+            })
+            .collect();
         StabilitySample {
-            time: sim.time(),
+            time,
             com,
             support_polygon: convex_hull(&contacts),
             margin: stability_margin(&contacts, [com[0], com[1]]),
             contacts,
-            roll_pitch: [rpy[0], rpy[1]],
-            body_collisions: sim.body_terrain_collisions(),
+            roll_pitch,
+            vertical_speed,
+            body_collisions,
         }
     }
 
-    /// Measures and records the current state.
-    pub fn observe(&mut self, sim: &Simulation) -> StabilitySample {
-        let s = Self::measure(sim);
-        self.record(&s);
-        s
-    }
-
-    /// Records a sample: minima and events.
+    /// Records a sample: minima, violations and events.
     pub fn record(&mut self, s: &StabilitySample) {
+        let dt = self.last_time.map_or(0.0, |t| (s.time - t).max(0.0));
+        self.last_time = Some(s.time);
         self.min_margin = self.min_margin.min(s.margin);
         self.min_wheels = self.min_wheels.min(s.contacts.len());
-        let tilt = s.roll_pitch[0].abs().max(s.roll_pitch[1].abs());
+        let tilt = s.tilt();
         self.max_tilt = self.max_tilt.max(tilt);
-        let tipping = s.margin < 0.0 || tilt > self.limits.max_tilt_rad;
-        if tipping && !self.tipped {
-            self.events.push(MonitorEvent::TipOver { time_s: s.time, margin_m: s.margin });
+
+        // Static stability: a violation lasts from the first sample outside to the first
+        // sample back inside.
+        if self.violation.is_some() {
+            self.static_violation_s += dt;
         }
-        self.tipped = tipping;
+        if s.margin < 0.0 {
+            let v = self.violation.get_or_insert(OpenViolation { start: s.time, worst: 0.0 });
+            v.worst = v.worst.min(s.margin);
+            self.worst_violation_m = self.worst_violation_m.min(s.margin);
+        } else {
+            self.close_violation(s.time);
+        }
+
+        // Tip-over.
+        let cause = if tilt > self.limits.max_tilt_rad {
+            Some(TipCause::Tilt)
+        } else if s.body_collisions.iter().any(|b| b == TRUNK_BODY) {
+            Some(TipCause::TrunkContact)
+        } else if s.vertical_speed < -self.limits.fall_speed_m_s {
+            Some(TipCause::Fall)
+        } else {
+            None
+        };
+        if let Some(cause) = cause
+            && !self.tipped
+        {
+            self.events.push(MonitorEvent::TipOver {
+                time_s: s.time,
+                cause,
+                tilt_deg: tilt.to_degrees(),
+            });
+        }
+        self.tipped = cause.is_some();
+
+        // Contact events.
         let lost = s.contacts.len() < self.limits.expected_wheels;
         if lost && !self.contact_lost {
             self.events
@@ -150,7 +320,24 @@ impl StabilityMonitor {
         self.colliding.clone_from(&s.body_collisions);
     }
 
-    /// Whether a tip-over was seen.
+    fn close_violation(&mut self, now: f64) {
+        if let Some(v) = self.violation.take() {
+            self.events.push(MonitorEvent::StaticViolation {
+                start_s: v.start,
+                duration_s: now - v.start,
+                worst_margin_m: v.worst,
+            });
+        }
+    }
+
+    /// Ends the run: a violation still under way is reported.
+    pub fn finish(&mut self) {
+        if let Some(t) = self.last_time {
+            self.close_violation(t);
+        }
+    }
+
+    /// Whether the robot fell over.
     pub fn tipped(&self) -> bool {
         self.events.iter().any(|e| matches!(e, MonitorEvent::TipOver { .. }))
     }
@@ -168,5 +355,122 @@ impl StabilityMonitor {
         v.sort();
         v.dedup();
         v
+    }
+}
+
+/// One wheel as the simulation reports it.
+#[derive(Debug, Clone, Copy)]
+struct WheelReading {
+    /// Leg index · 2 + wheel.
+    index: usize,
+    position: [f64; 2],
+    distance: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Eight wheels of a 1 m × 0.6 m footprint around the origin, at `distance`.
+    fn wheels(distance: f64) -> Vec<WheelReading> {
+        let mut v = Vec::new();
+        for (leg, (x, y)) in [(0.5, 0.3), (0.5, -0.3), (-0.5, 0.3), (-0.5, -0.3)].iter().enumerate()
+        {
+            for (w, dy) in [0.06, -0.06].iter().enumerate() {
+                v.push(WheelReading { index: leg * 2 + w, position: [*x, y + dy], distance });
+            }
+        }
+        v
+    }
+
+    fn level(m: &mut StabilityMonitor, t: f64, com: [f64; 2], w: &[WheelReading]) -> StabilitySample {
+        let s = m.sample(t, [com[0], com[1], 0.5], w, [0.0, 0.0], 0.0, Vec::new());
+        m.record(&s);
+        s
+    }
+
+    #[test]
+    fn a_wheel_hovering_within_the_gap_still_supports() {
+        // All wheels 3 mm up (inside MuJoCo's 4 mm gap, outside "touching"): a full
+        // footprint; the outer wheels stand at |y| = 0.36 and |x| = 0.5, so the margin of
+        // the centre is 0.36.
+        let mut m = StabilityMonitor::new(MonitorLimits::default());
+        let s = level(&mut m, 0.0, [0.0, 0.0], &wheels(0.003));
+        assert_eq!(s.contacts.len(), 8);
+        assert!((s.margin - 0.36).abs() < 1e-12, "{}", s.margin);
+        // 6 mm up and never touched: not supporting.
+        let mut m = StabilityMonitor::new(MonitorLimits::default());
+        let s = level(&mut m, 0.0, [0.0, 0.0], &wheels(0.006));
+        assert!(s.contacts.is_empty() && s.margin == f64::NEG_INFINITY);
+    }
+
+    #[test]
+    fn a_bounce_shorter_than_the_memory_is_no_violation() {
+        let mut m = StabilityMonitor::new(MonitorLimits::default());
+        level(&mut m, 0.00, [0.0, 0.0], &wheels(0.0));
+        // The whole robot in the air for 20 ms (two ticks), then down again.
+        for t in [0.01, 0.02] {
+            let s = level(&mut m, t, [0.0, 0.0], &[]);
+            assert_eq!(s.contacts.len(), 8, "remembered at {t}");
+        }
+        level(&mut m, 0.03, [0.0, 0.0], &wheels(0.0));
+        assert_eq!(m.static_violation_s, 0.0);
+        assert!(!m.tipped());
+        // Airborne for longer than the memory: the support is gone.
+        let s = level(&mut m, 0.07, [0.0, 0.0], &[]);
+        assert!(s.contacts.is_empty());
+    }
+
+    #[test]
+    fn a_violation_is_timed_and_its_worst_margin_kept_but_is_no_tip_over() {
+        let mut m = StabilityMonitor::new(MonitorLimits::default());
+        // The four left wheels only: their hull spans y ∈ [0.24, 0.36]; the CoM at
+        // y = 0.14 is 0.10 m outside.
+        let left: Vec<WheelReading> =
+            wheels(0.0).into_iter().filter(|w| [0, 1, 4, 5].contains(&w.index)).collect();
+        level(&mut m, 0.0, [0.0, 0.0], &wheels(0.0));
+        for k in 1..=10 {
+            level(&mut m, 0.1 + 0.01 * f64::from(k), [0.0, 0.14], &left);
+        }
+        level(&mut m, 0.3, [0.0, 0.0], &wheels(0.0));
+        m.finish();
+        // Memory keeps the right wheels until 0.03 s after their last touch (0.0 s), so
+        // from the first sample at 0.11 s the support is the left wheels.
+        let v: Vec<_> = m
+            .events
+            .iter()
+            .filter_map(|e| match e {
+                MonitorEvent::StaticViolation { start_s, duration_s, worst_margin_m } => {
+                    Some((*start_s, *duration_s, *worst_margin_m))
+                }
+                _ => None,
+            })
+            .collect();
+        assert_eq!(v.len(), 1, "{:?}", m.events);
+        assert!((v[0].0 - 0.11).abs() < 1e-9 && (v[0].1 - 0.19).abs() < 1e-9, "{v:?}");
+        assert!((v[0].2 + 0.10).abs() < 1e-9, "{v:?}");
+        // The total is the events' durations.
+        assert!((m.static_violation_s - 0.19).abs() < 1e-9, "{}", m.static_violation_s);
+        assert!((m.worst_violation_m + 0.10).abs() < 1e-9);
+        assert!(!m.tipped(), "level robot: a violation, not a fall");
+    }
+
+    #[test]
+    fn tilt_trunk_contact_and_a_fall_are_tip_overs() {
+        let tip = |roll: f64, vz: f64, bodies: Vec<String>| {
+            let mut m = StabilityMonitor::new(MonitorLimits::default());
+            let s = m.sample(0.0, [0.0, 0.0, 0.5], &wheels(0.0), [roll, 0.0], vz, bodies);
+            m.record(&s);
+            m.events.iter().find_map(|e| match e {
+                MonitorEvent::TipOver { cause, .. } => Some(*cause),
+                _ => None,
+            })
+        };
+        assert_eq!(tip(0.0, 0.0, vec![]), None);
+        assert_eq!(tip(40f64.to_radians(), 0.0, vec![]), Some(TipCause::Tilt));
+        assert_eq!(tip(0.0, 0.0, vec!["base".into()]), Some(TipCause::TrunkContact));
+        assert_eq!(tip(0.0, -1.0, vec![]), Some(TipCause::Fall));
+        // A shin on a stair nosing is a collision event, not a fall.
+        assert_eq!(tip(0.0, 0.0, vec!["fl_shin".into()]), None);
     }
 }

@@ -25,7 +25,7 @@ use crate::motion::{DetailedPath, MotionError, MotionOptions, Phase, expand_path
 use crate::progress::SimProgress;
 use crate::robot::Leg;
 use crate::robot::ik::IkError;
-use crate::scenario::{Scenario, Stepping};
+use crate::scenario::{Outcome, Scenario, Stepping};
 use crate::sim::{SimError, Simulation};
 use crate::terrain::HeightMap;
 use crate::viz::{Recorder, VizError};
@@ -190,6 +190,23 @@ pub struct ExpectationResult {
     pub detail: String,
 }
 
+/// Why a run stopped short of the goal, for machines (`run --json`, `check`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureKind {
+    /// The planner proved there is no path (every reachable pose searched).
+    NoPath,
+    /// The planner found no path within its time limit (not a proof).
+    PlanningTimeLimit,
+    /// The planner returned a path its motion generator could not expand: a bug of the
+    /// shared feasibility model, never a property of the course.
+    MotionGeneration,
+    /// The executor left the plan and no replan was left or a replan failed.
+    Replanning,
+    /// The scenario's simulated-time budget ran out.
+    Timeout,
+}
+
 /// Result of a run, as printed by `--json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct RunSummary {
@@ -229,13 +246,21 @@ pub struct RunSummary {
     pub step_margins: Vec<StepMargin>,
     /// What the executor did (lifts, corrections, steps, failures).
     pub executor_events: Vec<ExecEvent>,
-    /// Why the run stopped early, if it did (replan failed, replans exhausted).
+    /// Why the run stopped early, if it did (no path, replan failed, replans exhausted).
     pub failure: Option<String>,
+    /// The kind of that failure.
+    pub failure_kind: Option<FailureKind>,
     /// The push and the margins around it, if one was applied.
     pub push: Option<PushReport>,
-    /// Smallest measured stability margin after settling, m.
+    /// Smallest measured stability margin after settling, m (over the supporting wheels,
+    /// see `monitor`).
     pub min_stability_margin_m: f64,
-    /// A tip-over was seen.
+    /// Total time the CoM lay outside the support polygon, s.
+    pub static_violation_s: f64,
+    /// Most negative margin of those violations, m (0 if none).
+    pub worst_static_violation_m: f64,
+    /// The robot fell over (tilt past the limit, trunk on the terrain, or a fall); a
+    /// static-stability violation alone is not a tip-over.
     pub tipped: bool,
     /// Robot bodies other than wheels that touched terrain.
     pub body_collisions: Vec<String>,
@@ -281,7 +306,19 @@ impl Noise {
 fn expectations(scenario: &Scenario, s: &RunSummary) -> Vec<ExpectationResult> {
     let e = &scenario.expect;
     let mut out = Vec::new();
-    if e.reach_goal {
+    if e.outcome == Outcome::NoPath {
+        out.push(ExpectationResult {
+            name: "outcome",
+            passed: s.failure_kind == Some(FailureKind::NoPath),
+            detail: match (&s.failure_kind, &s.failure) {
+                (Some(FailureKind::NoPath), _) => "no path, as expected".into(),
+                (_, Some(f)) => format!("\"no path\" expected, got: {f}"),
+                (_, None) => format!("\"no path\" expected, got a plan of {} steps", s.plan_steps),
+            },
+        });
+        return out;
+    }
+    {
         out.push(ExpectationResult {
             name: "reach_goal",
             passed: s.reached_goal,
@@ -323,6 +360,14 @@ fn expectations(scenario: &Scenario, s: &RunSummary) -> Vec<ExpectationResult> {
         detail: format!(
             "{:.3} m measured, {} m required",
             s.min_stability_margin_m, e.min_stability_margin_m
+        ),
+    });
+    out.push(ExpectationResult {
+        name: "static_violation",
+        passed: s.static_violation_s <= e.max_static_violation_s,
+        detail: format!(
+            "{:.3} s with the CoM outside the support (worst {:.3} m), {} s allowed",
+            s.static_violation_s, s.worst_static_violation_m, e.max_static_violation_s
         ),
     });
     out.push(ExpectationResult {
@@ -391,9 +436,68 @@ pub fn expand_mission(
 pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobError> {
     let wall = Instant::now();
     let mut sim = Simulation::new(scenario, &opts.model_path)?;
-    let mission = plan_mission(scenario, &mut sim, &opts.plan)?;
+    let mission = match plan_mission(scenario, &mut sim, &opts.plan) {
+        Ok(m) => m,
+        Err(e) => return unexecuted(scenario, e, wall),
+    };
     super::stand_at_start(&mut sim, scenario)?;
     execute(scenario, &mut sim, mission, opts, wall)
+}
+
+/// The summary of a run that never started executing because planning ended without a
+/// path or the plan could not be expanded; other errors pass through.
+fn unexecuted(
+    scenario: &Scenario,
+    e: RunJobError,
+    wall: Instant,
+) -> Result<RunSummary, RunJobError> {
+    let kind = match &e {
+        RunJobError::Plan(PlanJobError::NoPath { termination, .. }) => match termination {
+            crate::planner::Termination::NoPath => FailureKind::NoPath,
+            _ => FailureKind::PlanningTimeLimit,
+        },
+        RunJobError::Motion { .. } => FailureKind::MotionGeneration,
+        _ => return Err(e),
+    };
+    let planning_time_s = wall.elapsed().as_secs_f64();
+    let mut summary = RunSummary {
+        scenario: scenario.name.clone(),
+        passed: false,
+        reached_goal: false,
+        goal_position_error_m: (scenario.start.x - scenario.goal.x)
+            .hypot(scenario.start.y - scenario.goal.y),
+        goal_heading_error_rad: wrap_angle(scenario.start.theta - scenario.goal.theta),
+        sim_time_s: 0.0,
+        wall_time_s: planning_time_s,
+        real_time_factor: 0.0,
+        planning_time_s,
+        plan_cost: 0.0,
+        plan_steps: 0,
+        steps_executed: 0,
+        steps_planned: 0,
+        steps_aborted: 0,
+        replans: 0,
+        keyframes: 0,
+        step_margins: Vec::new(),
+        executor_events: Vec::new(),
+        failure: Some(chain(&e)),
+        failure_kind: Some(kind),
+        push: None,
+        min_stability_margin_m: f64::INFINITY,
+        static_violation_s: 0.0,
+        worst_static_violation_m: 0.0,
+        tipped: false,
+        body_collisions: Vec::new(),
+        max_tracking_error_m: 0.0,
+        mean_tracking_error_m: 0.0,
+        max_pitch_deg: 0.0,
+        max_tilt_deg: 0.0,
+        expectations: Vec::new(),
+        events: Vec::new(),
+    };
+    summary.expectations = expectations(scenario, &summary);
+    summary.passed = summary.expectations.iter().all(|e| e.passed);
+    Ok(summary)
 }
 
 /// An error and its sources, joined by ": ".
@@ -421,6 +525,7 @@ fn observe(sim: &Simulation, measured: Pose2) -> Observation {
         wheel_contacts: sim
             .wheel_contacts()
             .iter()
+            .filter(|c| c.touching())
             .map(|c| (c.leg, [c.position[0], c.position[1]]))
             .collect(),
     }
@@ -481,7 +586,8 @@ pub fn execute(
     let dt = sim.timestep();
     let substeps = ((1.0 / CONTROL_HZ) / dt).round().max(1.0) as usize;
     let control_dt = substeps as f64 * dt;
-    let mut monitor = StabilityMonitor::new(MonitorLimits::default());
+    let mut monitor =
+        StabilityMonitor::new(MonitorLimits { settle_s: SETTLE_S, ..MonitorLimits::default() });
     let mut noise = opts.noise.map(|n| (n, Noise::new(n.seed)));
     let timeout = scenario.expect.timeout_s;
     let progress = SimProgress::new(&scenario.name, timeout, opts.progress);
@@ -595,10 +701,7 @@ pub fn execute(
         }
         sim.step(substeps)?;
         tick += 1;
-        let sample = StabilityMonitor::measure(sim);
-        if sim.time() >= SETTLE_S {
-            monitor.record(&sample);
-        }
+        let sample = monitor.observe(sim);
         last_margin = sample.margin;
         if let (Some(r), Some(p)) = (&mut push_report, &opts.push)
             && sim.time() <= r.start_s + p.duration_s + 2.0
@@ -644,12 +747,15 @@ pub fn execute(
         progress.set(sim.time());
     }
     progress.finish();
+    monitor.finish();
     let exec_wall_s = (exec_wall.elapsed().as_secs_f64() - replan_wall).max(1e-9);
     if let Some(r) = recorder.take() {
         r.finish()?;
     }
+    let mut failure_kind = failure.as_ref().map(|_| FailureKind::Replanning);
     if !finished && failure.is_none() {
         failure = Some(format!("time budget of {timeout} s used up"));
+        failure_kind = Some(FailureKind::Timeout);
     }
     done_events.append(&mut exec.events);
     let base = sim.base();
@@ -679,8 +785,11 @@ pub fn execute(
         step_margins,
         executor_events: done_events,
         failure,
+        failure_kind,
         push: push_report,
         min_stability_margin_m: monitor.min_margin,
+        static_violation_s: monitor.static_violation_s,
+        worst_static_violation_m: monitor.worst_violation_m,
         tipped: monitor.tipped(),
         body_collisions: monitor.collided_bodies(),
         max_tracking_error_m: max_track,

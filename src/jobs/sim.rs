@@ -144,7 +144,8 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
     let feet = robot.neutral_footprint();
     let target = opts.drive.unwrap_or_default();
     let mut twist = Twist::default();
-    let mut monitor = StabilityMonitor::new(MonitorLimits::default());
+    let mut monitor =
+        StabilityMonitor::new(MonitorLimits { settle_s: SETTLE_S, ..MonitorLimits::default() });
     let progress = SimProgress::new(&scenario.name, opts.duration_s, opts.progress);
     let base_start = pose4(&sim);
     let wall = Instant::now();
@@ -165,10 +166,7 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
         }
         sim.step(substeps)?;
         tick += 1;
-        let sample = crate::monitor::StabilityMonitor::measure(&sim);
-        if sim.time() >= SETTLE_S {
-            monitor.record(&sample);
-        }
+        let sample = monitor.observe(&sim);
         if let Some(r) = &recorder
             && tick.is_multiple_of(record_every)
         {
@@ -178,6 +176,7 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
         progress.set(sim.time());
     }
     progress.finish();
+    monitor.finish();
     let wall_time_s = wall.elapsed().as_secs_f64();
     if let Some(r) = recorder.take() {
         r.finish()?;

@@ -99,12 +99,24 @@ pub enum Stepping {
     Forbidden,
 }
 
+/// What the right answer to a scenario is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// The robot must reach the goal within the tolerances.
+    #[default]
+    Reach,
+    /// The course is impossible: the planner must answer "no path" (and nothing may be
+    /// executed).
+    NoPath,
+}
+
 /// What a closed-loop run of the scenario must show to pass.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Expectations {
-    /// The robot must reach the goal within the tolerances.
-    pub reach_goal: bool,
+    /// The right answer: reach the goal, or a clean "no path".
+    pub outcome: Outcome,
     /// Position tolerance at the goal, m.
     pub goal_tolerance_m: f64,
     /// Heading tolerance at the goal, degrees.
@@ -113,6 +125,9 @@ pub struct Expectations {
     pub stepping: Stepping,
     /// Minimum static stability margin measured during the run, m.
     pub min_stability_margin_m: f64,
+    /// Longest total time the measured CoM may lie outside the support polygon of the
+    /// supporting wheels (a static-stability violation, see `monitor`), s.
+    pub max_static_violation_s: f64,
     /// Simulated-time budget of a run, s.
     pub timeout_s: f64,
 }
@@ -120,15 +135,26 @@ pub struct Expectations {
 impl Default for Expectations {
     fn default() -> Self {
         Self {
-            reach_goal: true,
+            outcome: Outcome::Reach,
             goal_tolerance_m: 0.1,
             goal_tolerance_deg: 10.0,
             stepping: Stepping::Any,
             min_stability_margin_m: 0.0,
+            max_static_violation_s: DEFAULT_MAX_STATIC_VIOLATION_S,
             timeout_s: 120.0,
         }
     }
 }
+
+/// Default bound on the total duration of static-stability violations in a run, s: a
+/// few control ticks of a wheel bouncing on a bump edge, never a lean that lasts.
+pub const DEFAULT_MAX_STATIC_VIOLATION_S: f64 = 0.1;
+
+/// Largest height map a scenario may ask for, in cells (at the scenario's grid
+/// resolution, margin included): 4 M cells is a 50 m × 50 m map at 2.5 cm, about
+/// 200 MB of planner memory. Larger maps are refused with the cell count, not left to
+/// abort in an allocation.
+pub const MAX_MAP_CELLS: f64 = 4.0e6;
 
 /// The file format, exactly as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -137,6 +163,7 @@ struct ScenarioFile {
     name: Option<String>,
     #[serde(default)]
     description: String,
+    class: Option<String>,
     map: MapExtent,
     start: PoseSpec,
     goal: PoseSpec,
@@ -157,6 +184,9 @@ pub struct Scenario {
     pub path: PathBuf,
     /// One-line description.
     pub description: String,
+    /// The class of course (`stairs`, `clutter`, ...; see `momaro generate`), for the
+    /// per-class totals of `momaro check`; `None` for hand-written scenarios.
+    pub class: Option<String>,
     /// Map extent.
     pub map: MapExtent,
     /// Start pose.
@@ -204,6 +234,7 @@ impl Scenario {
             name,
             path: path.to_owned(),
             description: file.description,
+            class: file.class,
             map: file.map,
             start: file.start.pose(),
             goal: file.goal.pose(),
@@ -266,6 +297,21 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
             "map.y_max".into(),
             format!("{} must exceed map.y_min = {}", m.y_max, m.y_min),
         ));
+    }
+    // The height map covers the extent plus r_N on every side (`terrain::rasterise`).
+    let res = f.params.grid_resolution_m;
+    if res.is_finite() && res > 0.0 {
+        let pad = 2.0 * f.params.r_n_m;
+        let cells = ((m.x_max - m.x_min + pad) / res).ceil() * ((m.y_max - m.y_min + pad) / res).ceil();
+        if !(cells <= MAX_MAP_CELLS) {
+            return Err((
+                "map".into(),
+                format!(
+                    "{:.3e} cells of {res} m, more than the limit of {MAX_MAP_CELLS:.0} (a 50 m x 50 m map at 2.5 cm)",
+                    cells
+                ),
+            ));
+        }
     }
     for (name, p) in [("start", &f.start), ("goal", &f.goal)] {
         finite(&format!("{name}.x"), p.x)?;
@@ -330,6 +376,12 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
     non_negative("expect.goal_tolerance_m", e.goal_tolerance_m)?;
     non_negative("expect.goal_tolerance_deg", e.goal_tolerance_deg)?;
     finite("expect.min_stability_margin_m", e.min_stability_margin_m)?;
+    non_negative("expect.max_static_violation_s", e.max_static_violation_s)?;
+    if let Some(c) = &f.class
+        && (c.is_empty() || !c.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_'))
+    {
+        return Err(("class".into(), format!("`{c}` must be a non-empty word of a-z, 0-9 and _")));
+    }
     positive("expect.timeout_s", e.timeout_s)?;
     Ok(())
 }
@@ -419,7 +471,8 @@ mod tests {
         assert_eq!(s.params.k12, 1.5);
         assert_eq!(s.params.k1, 100.0);
         assert!((s.goal.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
-        assert!(s.expect.reach_goal);
+        assert_eq!(s.expect.outcome, Outcome::Reach);
+        assert_eq!(s.class, None);
         assert_eq!(s.terrain_height(2.0, 1.5), 0.2);
     }
 
@@ -471,6 +524,37 @@ mod tests {
             .replace("size = [0.5, 0.5]", "size = [3.0, 3.0]")
             .replace("height = 0.2", "height = 0.5");
         parse(&text).unwrap();
+    }
+
+    #[test]
+    fn a_map_too_large_to_allocate_names_map_and_its_cells() {
+        // 1 km x 1 km at 2.5 cm: 1.6e9 cells.
+        let text = GOOD.replace("x_max = 5.0", "x_max = 999.0").replace("y_max = 2.0", "y_max = 998.0");
+        match parse(&text) {
+            Err(ScenarioError::Invalid { field, reason, .. }) => {
+                assert_eq!(field, "map");
+                assert!(reason.contains("1.6") && reason.contains("4000000"), "{reason}");
+            }
+            other => panic!("expected an invalid map, got {other:?}"),
+        }
+        // 49 m x 49 m is fine.
+        let text = GOOD.replace("x_max = 5.0", "x_max = 48.0").replace("y_max = 2.0", "y_max = 47.0");
+        parse(&text).unwrap();
+    }
+
+    #[test]
+    fn outcome_and_class_parse_and_bad_values_name_their_field() {
+        let s = parse(&format!("class = \"stairs\"\n{GOOD}\n[expect]\noutcome = \"no_path\"\n"))
+            .unwrap();
+        assert_eq!(s.expect.outcome, Outcome::NoPath);
+        assert_eq!(s.class.as_deref(), Some("stairs"));
+        let e = parse(&format!("{GOOD}\n[expect]\noutcome = \"maybe\"\n")).unwrap_err();
+        assert!(matches!(e, ScenarioError::Parse { .. }) && e.to_string().contains("outcome"), "{e}");
+        assert_eq!(field_of(&format!("class = \"a b\"\n{GOOD}")), "class");
+        assert_eq!(
+            field_of(&format!("{GOOD}\n[expect]\nmax_static_violation_s = -1\n")),
+            "expect.max_static_violation_s"
+        );
     }
 
     #[test]

@@ -75,16 +75,30 @@ struct LegIds {
     steer_body: usize,
 }
 
-/// A wheel touching the terrain, from MuJoCo's contact list.
+/// A wheel near or touching the terrain, from MuJoCo's contact list.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WheelContact {
     /// The leg.
     pub leg: Leg,
     /// 0 = left wheel of the pair, 1 = right.
     pub wheel: usize,
-    /// Contact position in the world, m.
+    /// Contact position in the world, m (the mean of the wheel's nearest contacts).
     pub position: [f64; 3],
+    /// Signed distance of the wheel from the terrain, m (negative = the foam is pressed
+    /// in): the smallest of its contacts.
+    pub distance: f64,
 }
+
+impl WheelContact {
+    /// Whether the wheel touches the terrain ([`TOUCHING_M`]).
+    pub fn touching(&self) -> bool {
+        self.distance <= TOUCHING_M
+    }
+}
+
+/// A wheel closer to the terrain than this touches it, m: the controllers' idea of
+/// contact (foot placement, the lift guard).
+pub const TOUCHING_M: f64 = 1e-3;
 
 /// Pose of the robot's base in the world.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -420,41 +434,48 @@ impl Simulation {
         std::array::from_fn(|i| xpos[self.legs[i].steer_body])
     }
 
-    /// The wheels touching terrain now, one entry per wheel (contact points of a wheel are
-    /// averaged), in leg order.
+    /// The wheels MuJoCo reports near the terrain now (within the wheels' contact `gap`,
+    /// 4 mm: see `models/momaro.xml`), one entry per wheel in leg order, with the wheel's
+    /// smallest distance. [`WheelContact::touching`] tells those in contact.
     pub fn wheel_contacts(&self) -> Vec<WheelContact> {
-        let mut sums = [[([0.0; 3], 0u32); 2]; 4];
+        // Per wheel: smallest distance, and the sum and count of contact points within
+        // 1 mm of it (a wheel on a box edge has two contacts; both carry it).
+        let mut best = [[(f64::INFINITY, [0.0; 3], 0u32); 2]; 4];
         for c in self.data.contact() {
             let (g1, g2) = (c.geom1, c.geom2);
             let (Ok(g1), Ok(g2)) = (usize::try_from(g1), usize::try_from(g2)) else { continue };
-            // Only penetrating or touching contacts count, not those inside the margin.
-            if c.dist > 1e-3 {
-                continue;
-            }
             let (wheel, other) = if self.terrain_geoms[g2] { (g1, g2) } else { (g2, g1) };
             if !self.terrain_geoms[other] {
                 continue;
             }
-            for (ids, leg_sums) in self.legs.iter().zip(sums.iter_mut()) {
-                for (geom, (sum, n)) in ids.wheel_geoms.iter().zip(leg_sums.iter_mut()) {
-                    if *geom == wheel {
+            for (ids, leg_best) in self.legs.iter().zip(best.iter_mut()) {
+                for (geom, (dist, sum, n)) in ids.wheel_geoms.iter().zip(leg_best.iter_mut()) {
+                    if *geom != wheel {
+                        continue;
+                    }
+                    if c.dist < *dist - TOUCHING_M {
+                        // A clearly nearer contact replaces the ones seen so far.
+                        (*dist, *sum, *n) = (c.dist, c.pos, 1);
+                    } else if c.dist <= *dist + TOUCHING_M {
                         for (acc, p) in sum.iter_mut().zip(c.pos) {
                             *acc += p;
                         }
                         *n += 1;
+                        *dist = dist.min(c.dist);
                     }
                 }
             }
         }
         let mut out = Vec::with_capacity(8);
         for leg in Leg::ALL {
-            for (w, (sum, n)) in sums[leg.index()].iter().enumerate() {
+            for (w, (dist, sum, n)) in best[leg.index()].iter().enumerate() {
                 if *n > 0 {
                     let k = f64::from(*n);
                     out.push(WheelContact {
                         leg,
                         wheel: w,
                         position: [sum[0] / k, sum[1] / k, sum[2] / k],
+                        distance: *dist,
                     });
                 }
             }
@@ -470,7 +491,7 @@ impl Simulation {
             let (Ok(g1), Ok(g2)) = (usize::try_from(c.geom1), usize::try_from(c.geom2)) else {
                 continue;
             };
-            if c.dist > 1e-3 {
+            if c.dist > TOUCHING_M {
                 continue;
             }
             let robot_geom = match (self.terrain_geoms[g1], self.terrain_geoms[g2]) {
