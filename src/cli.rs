@@ -496,7 +496,8 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 noise,
                 ..jobs::run::RunOptions::new(planner.options(), model.model)
             };
-            let s = match load(&scenario).and_then(|sc| jobs::run::run(&sc, &opts).map_err(run_error))
+            let s = match load(&scenario)
+                .and_then(|sc| jobs::run::run(&sc, &opts).map_err(run_error))
             {
                 Ok(s) => s,
                 Err(e) => {

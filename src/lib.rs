@@ -6,6 +6,7 @@ pub mod cli;
 pub mod control;
 pub mod cost;
 pub mod cost_image;
+pub mod feasibility;
 pub mod geometry;
 pub mod jobs;
 pub mod locomotion;

@@ -101,6 +101,8 @@ pub struct CostMaps {
     disc_max: DiscMaxLayer,
     /// Heights dilated by two cells (5 cm): the terrain a leg point must clear.
     leg_terrain: HeightMap,
+    /// Heights dilated by `SWEEP_CELLS` more: what the planner's lattice poses check.
+    swept_leg_terrain: HeightMap,
     body: BodyGeometry,
     weights: PoseWeights,
     neutral_footprint: [[f64; 2]; 4],
@@ -148,6 +150,7 @@ impl CostMaps {
             foot_cells,
             disc_max: DiscMaxLayer::compute(map, params.base_circle_radius_m),
             leg_terrain: map.dilated_max(LEG_TERRAIN_CELLS),
+            swept_leg_terrain: map.dilated_max(LEG_TERRAIN_CELLS + crate::feasibility::SWEEP_CELLS),
             body,
             weights: PoseWeights { k4: params.k4, k5: params.k5, k6: params.k6 },
             neutral_footprint: robot.neutral_footprint(),
@@ -165,6 +168,14 @@ impl CostMaps {
     /// leg segment (capsule radius 2.5 cm) over it could touch (`motion::standing`).
     pub fn leg_terrain(&self) -> &HeightMap {
         &self.leg_terrain
+    }
+
+    /// The heights dilated by [`crate::feasibility::SWEEP_CELLS`] more cells than
+    /// [`Self::leg_terrain`]: the planner checks lattice poses against it, so that the
+    /// legs clear the terrain everywhere between two neighbouring poses
+    /// (`feasibility`).
+    pub fn swept_leg_terrain(&self) -> &HeightMap {
+        &self.swept_leg_terrain
     }
 
     /// The foot-cost layer.

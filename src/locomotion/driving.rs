@@ -47,7 +47,7 @@ pub trait PoseCostSource {
     fn driving_cost(&self, pose: &Pose2) -> Option<f64>;
 }
 
-impl PoseCostSource for crate::cost::CostMaps {
+impl PoseCostSource for &crate::cost::CostMaps {
     fn driving_cost(&self, pose: &Pose2) -> Option<f64> {
         self.driving_pose_cost(pose).finite()
     }
@@ -105,8 +105,8 @@ impl DrivingGoal {
 }
 
 /// The driving graph over one cost map.
-pub struct DrivingGraph<'c, C: PoseCostSource> {
-    costs: &'c C,
+pub struct DrivingGraph<C: PoseCostSource> {
+    costs: C,
     lattice: Lattice,
     config: DrivingConfig,
     goal: DrivingGoal,
@@ -139,9 +139,9 @@ pub(crate) fn heuristic_cost(units: f64) -> Cost {
     Cost::from_f64_floor(units * (1.0 - 1e-9))
 }
 
-impl<'c, C: PoseCostSource> DrivingGraph<'c, C> {
+impl<C: PoseCostSource> DrivingGraph<C> {
     /// A driving graph on `lattice` with costs from `costs`, searching for `goal`.
-    pub fn new(costs: &'c C, lattice: Lattice, config: DrivingConfig, goal: DrivingGoal) -> Self {
+    pub fn new(costs: C, lattice: Lattice, config: DrivingConfig, goal: DrivingGoal) -> Self {
         let moves = config.neighbourhood.moves();
         let mut move_weight = Vec::with_capacity(moves.len() * usize::from(lattice.orientations));
         for k in 0..lattice.orientations {
@@ -219,7 +219,7 @@ impl<'c, C: PoseCostSource> DrivingGraph<'c, C> {
     }
 }
 
-impl<C: PoseCostSource> SearchGraph for DrivingGraph<'_, C> {
+impl<C: PoseCostSource> SearchGraph for DrivingGraph<C> {
     type State = LatticeState;
 
     fn successors(&mut self, s: LatticeState, out: &mut Vec<(LatticeState, Cost)>) {
@@ -315,7 +315,7 @@ pub enum Algorithm {
 /// A start or goal off the map, or invalid search parameters.
 #[allow(clippy::too_many_arguments)]
 pub fn plan_driving<C: PoseCostSource>(
-    costs: &C,
+    costs: C,
     lattice: Lattice,
     config: DrivingConfig,
     start: &Pose2,

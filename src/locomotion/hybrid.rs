@@ -83,11 +83,12 @@
 //! proofs are in the `heuristic` module docs; `locomotion::tests` checks
 //! `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge.
 
-use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, edge_cost};
+use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, edge_cost};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{StepBound, StepBoundParams};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use crate::cost::{Cost as CostValue, CostMaps};
+use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
 use crate::motion::kinematics::hips_in_world;
 use crate::motion::standing::{StandingRule, com_estimate};
@@ -205,6 +206,10 @@ pub struct HybridConfig {
     pub foot_move_increment_m: f64,
     /// Cap on distinct footprints (graph size guard).
     pub max_footprints: usize,
+    /// Driving leg height (Sec. VI-B), m: the driving posture the feasibility model checks.
+    pub driving_leg_height_m: f64,
+    /// Smallest stability margin of a posture, m (the generator's requirement).
+    pub min_stability_margin_m: f64,
 }
 
 impl HybridConfig {
@@ -228,6 +233,8 @@ impl HybridConfig {
             step_support_margin_m: params.step_support_margin_m,
             foot_move_increment_m: 0.1,
             max_footprints: 65_536,
+            driving_leg_height_m: params.driving_leg_height_m,
+            min_stability_margin_m: params.min_stability_margin_m,
         }
     }
 }
@@ -261,7 +268,7 @@ pub struct ManoeuvreStats {
 /// The hybrid graph over one cost map.
 pub struct HybridGraph<'c> {
     maps: &'c CostMaps,
-    driving: DrivingGraph<'c, CostMaps>,
+    driving: DrivingGraph<FeasibleDriving<'c>>,
     config: HybridConfig,
     lattice: Lattice,
     /// Neutral foot positions in the base frame (x', y'), FL, FR, RL, RR.
@@ -290,6 +297,21 @@ pub struct HybridGraph<'c> {
     /// footprint is entered from several predecessors, and each check runs the standing
     /// rule's IK.
     standable: HashMap<(i16, i16, u8, FootOffsets), bool, FxBuild>,
+}
+
+/// Driving pose costs of the cost client where the shared feasibility model admits the
+/// driving posture (`feasibility::DrivingCheck::lattice_pose`), none elsewhere: the
+/// driving graph memoises both per lattice pose.
+struct FeasibleDriving<'c> {
+    maps: &'c CostMaps,
+    check: DrivingCheck,
+}
+
+impl PoseCostSource for FeasibleDriving<'_> {
+    fn driving_cost(&self, pose: &Pose2) -> Option<f64> {
+        let cost = self.maps.driving_pose_cost(pose).finite()?;
+        self.check.lattice_pose(self.maps, pose).ok().map(|()| cost)
+    }
 }
 
 /// The offsets (cells, −64..=63) at which `leg` reaches its foot with the hip `height`
@@ -353,7 +375,20 @@ impl<'c> HybridGraph<'c> {
         let heuristic_setup = t0.elapsed();
         Ok(Self {
             maps,
-            driving: DrivingGraph::new(maps, lattice, config.driving, goal),
+            driving: DrivingGraph::new(
+                FeasibleDriving {
+                    maps,
+                    check: DrivingCheck::from_parts(
+                        robot,
+                        config.standing,
+                        config.driving_leg_height_m,
+                        config.min_stability_margin_m,
+                    ),
+                },
+                lattice,
+                config.driving,
+                goal,
+            ),
             near,
             config,
             lattice,

@@ -195,7 +195,7 @@ fn plan_driving_snaps_poses_and_reports_off_map() {
     let l = lattice(60, 64);
     let cfg = config(Neighbourhood::N20);
     let r = plan_driving(
-        &flat,
+        flat,
         l,
         cfg,
         &Pose2::new(0.26, 0.26, 0.0),
@@ -208,7 +208,7 @@ fn plan_driving_snaps_poses_and_reports_off_map() {
     assert_eq!(r.termination, Termination::OptimalProven);
     assert_eq!(r.best().map(|s| s.cost), Some(Cost::from_f64(0.75)));
     let off = plan_driving(
-        &flat,
+        flat,
         l,
         cfg,
         &Pose2::new(-0.5, 0.26, 0.0),
@@ -230,10 +230,10 @@ fn cost_maps_adapter_gives_one_on_flat_ground() {
     let costs = CostMaps::build(&map, &robot, &Params::default()).expect("cost maps");
     let l = Lattice::for_map(&map, 64).expect("lattice");
     let centre = l.pose(LatticeState::new(60, 60, 5));
-    let c = costs.driving_cost(&centre).expect("flat ground is traversable");
+    let c = (&costs).driving_cost(&centre).expect("flat ground is traversable");
     assert!((c - 1.0).abs() < 1e-9, "{c}");
     // Off the map: no cost.
-    assert_eq!(costs.driving_cost(&Pose2::new(-1.0, 0.0, 0.0)), None);
+    assert_eq!((&costs).driving_cost(&Pose2::new(-1.0, 0.0, 0.0)), None);
     // A drive across the middle of the flat map costs its length.
     let cfg =
         DrivingConfig::new(&Params::default(), &robot.neutral_footprint(), Neighbourhood::N16);

@@ -49,10 +49,12 @@
 use super::CenterOfMassModel;
 use super::keyframe::{DetailedPath, Keyframe, Phase};
 use super::kinematics;
+use super::kinematics::PostureError;
 use super::kinematics::{Evaluation, Posture, contacts_in_base, evaluate, interpolate, rotation};
 use super::roll::roll_for_lateral_com;
 use super::standing::{StandingRule, StepStance, base_z};
 use crate::cost::CostMaps;
+use crate::feasibility::{DrivingCheck, Infeasible};
 use crate::geometry::{Pose2, wrap_angle};
 use crate::jobs::plan::{PathElement, PathKind};
 use crate::params::Params;
@@ -294,7 +296,7 @@ impl Expander<'_> {
         a: &Posture,
         b: &Posture,
         drive: bool,
-    ) -> Result<SegmentCheck, String> {
+    ) -> Result<SegmentCheck, (f64, Infeasible)> {
         let o = self.o;
         let dist = |p: [f64; 3], q: [f64; 3]| {
             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
@@ -326,14 +328,11 @@ impl Expander<'_> {
                         .legs_clear(self.robot, self.maps.leg_terrain(), &p, &e.joints)
                         .map(|()| e)
                 })
-                .map_err(|e| format!("at {:.0} % of the segment: {e}", t * 100.0))?;
+                .map_err(|e| (t, Infeasible::Posture(e)))?;
             if e.margin < o.min_margin_m {
-                return Err(format!(
-                    "stability margin {:.3} m at {:.0} % of the segment (CoM {:.3}, {:.3})",
-                    e.margin,
-                    t * 100.0,
-                    e.com[0],
-                    e.com[1]
+                return Err((
+                    t,
+                    Infeasible::Margin { margin_m: e.margin, required_m: o.min_margin_m },
                 ));
             }
             min_margin = min_margin.min(e.margin);
@@ -342,7 +341,7 @@ impl Expander<'_> {
             }
             end = Some(e);
         }
-        let end = end.ok_or_else(|| "empty segment".to_owned())?;
+        let end = end.ok_or((0.0, Infeasible::Posture(PostureError::NoHeight)))?;
         Ok(SegmentCheck { end, min_margin, min_three, samples: n })
     }
 
@@ -359,15 +358,19 @@ impl Expander<'_> {
 
     /// Checks a sequence from the current posture without committing it; returns the
     /// keyframes and the sequence's smallest margin.
-    fn trial(&mut self, seq: &[Planned]) -> Result<(Vec<Keyframe>, f64, f64, usize), String> {
+    fn trial(
+        &mut self,
+        seq: &[Planned],
+    ) -> Result<(Vec<Keyframe>, f64, f64, usize), SegmentFailure> {
         let mut from = self.cur;
         let mut t = self.time;
         let mut out = Vec::with_capacity(seq.len());
         let (mut mm, mut m3, mut samples) = (f64::INFINITY, f64::INFINITY, 0);
         for &(phase, leg, p) in seq {
-            let c = self
-                .check_segment(&from, &p, phase == Phase::Drive)
-                .map_err(|e| format!("{}: {e}", phase.name()))?;
+            let c =
+                self.check_segment(&from, &p, phase == Phase::Drive).map_err(|(t, cause)| {
+                    SegmentFailure { phase: phase.name(), percent: t * 100.0, cause }
+                })?;
             t += self.duration(&from, &p);
             mm = mm.min(c.min_margin);
             m3 = m3.min(c.min_three);
@@ -405,10 +408,10 @@ impl Expander<'_> {
     }
 
     fn push(&mut self, kind: PathKind, seq: &[Planned]) -> Result<(), MotionError> {
-        let (k, mm, m3, s) = self.trial(seq).map_err(|reason| MotionError::Manoeuvre {
+        let (k, mm, m3, s) = self.trial(seq).map_err(|f| MotionError::Manoeuvre {
             index: self.index,
             kind: kind_name(kind),
-            reason,
+            reason: f.to_string(),
         })?;
         self.commit(k, mm, m3, s);
         Ok(())
@@ -651,10 +654,13 @@ impl Expander<'_> {
                     self.commit(k, mm, m3, s);
                     return Ok(());
                 }
-                Err(e) => {
-                    let m = margin_in(&e);
+                Err(f) => {
+                    let m = match f.cause {
+                        Infeasible::Margin { margin_m, .. } => margin_m,
+                        _ => f64::NEG_INFINITY,
+                    };
                     if m > best.0 || best.0 == f64::NEG_INFINITY {
-                        best = (m, e);
+                        best = (m, f.to_string());
                     }
                 }
             }
@@ -678,13 +684,16 @@ enum Shift {
     Fixed(f64),
 }
 
-/// The margin quoted in a failure message, −inf if none.
-fn margin_in(msg: &str) -> f64 {
-    msg.split("stability margin ")
-        .nth(1)
-        .and_then(|r| r.split(' ').next())
-        .and_then(|v| v.parse::<f64>().ok())
-        .unwrap_or(f64::NEG_INFINITY)
+/// Where a checked sequence failed: the phase, how far into its segment, and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{phase}: at {percent:.0} % of the segment: {cause}")]
+pub struct SegmentFailure {
+    /// The keyframe phase whose segment failed.
+    pub phase: &'static str,
+    /// Position along the segment, %.
+    pub percent: f64,
+    /// The cause.
+    pub cause: Infeasible,
 }
 
 /// Expands an abstract path (`jobs::plan::PlanSummary::path`) into a detailed path of
@@ -741,6 +750,12 @@ pub fn expand_path(
         segment_min_margin_m: e.margin,
         centroid_distance_m: e.centroid_distance,
     });
+    let check = DrivingCheck::from_parts(
+        robot,
+        options.standing,
+        options.driving_leg_height_m,
+        options.min_margin_m,
+    );
     let special = |k: PathKind| !matches!(k, PathKind::Start | PathKind::Drive | PathKind::Turn);
     let mut standing = false;
     let mut steps = 0;
@@ -769,9 +784,21 @@ pub fn expand_path(
                             theta: ex.cur.base_rpy[2],
                         };
                         let p = ex.driving(&pose)?;
-                        ex.push(el.kind, &[(Phase::Lower, None, p)])?;
-                        standing = false;
+                        // Lower only where the driving posture fits (`feasibility`).
+                        if check.posture_ok(&p, maps.leg_terrain()).is_ok() {
+                            ex.push(el.kind, &[(Phase::Lower, None, p)])?;
+                            standing = false;
+                        }
                     }
+                }
+                // Where the driving posture does not fit (a knee over a wall, a wheel
+                // folded past its limit), drive standing, as the planner's feasibility
+                // check allowed (`feasibility::DrivingCheck::lattice_pose`).
+                if !standing
+                    && check.posture_ok(&ex.driving(&el.pose)?, maps.leg_terrain()).is_err()
+                {
+                    ex.stand_up(el.kind)?;
+                    standing = true;
                 }
                 let target = if standing {
                     let feet = ex.neutral_feet(&el.pose)?;

@@ -201,7 +201,12 @@ pub fn pitch_from_feet(feet: &[[f64; 3]; 4], yaw: f64, pitch_fraction: f64) -> f
 
 /// The driving posture at `pose` (Sec. VI-B): the feet in the neutral footprint on the
 /// ground that `ground(x, y)` gives, the base pitched by `pitch_fraction` of the slope and
-/// its mean hip `leg_height` above the mean ground under the feet.
+/// raised so that the hip over the highest ground stands `leg_height` above it (the other
+/// legs stretch down to their lower ground), as Sec. VI-B sets the base for standing
+/// manoeuvres. The driving height folds the knees nearly to their limit (hip to ankle
+/// 9 cm of the 6 cm the knee allows), so a base set by the *mean* ground would fold the
+/// knee of a wheel on a 4 cm bump past its limit; set by the highest foot every wheel
+/// keeps the ground over whatever the foot cost lets it drive on (ΔH ≤ 5 cm).
 ///
 /// # Errors
 /// The (x, y) of a foot where `ground` knows no height.
@@ -225,8 +230,7 @@ pub fn driving_posture(
             let h = robot.hips[i];
             feet[i][2] + leg_height - (r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2])
         })
-        .sum::<f64>()
-        / 4.0;
+        .fold(f64::NEG_INFINITY, f64::max);
     Ok(Posture {
         base_position: [pose.x, pose.y, z],
         base_rpy: [0.0, pitch, pose.theta],
@@ -273,17 +277,18 @@ mod tests {
     #[test]
     fn driving_posture_on_a_slope_by_hand() {
         // Ground rising 0.1 per metre along +x; the feet at x = ±0.35 m see ±0.035 m, so the
-        // slope between front and rear is atan(0.1) and the pitch −0.7·atan(0.1). The mean
-        // ground is 0, so the base origin sits 0.27 m plus the hips' offset above it:
-        // z = 0.27 − (−0.05)·cos(pitch) (the hips are 0.05 m below the origin, at x' = ±0.35
-        // whose pitch terms cancel).
+        // slope between front and rear is atan(0.1) and the pitch −0.7·atan(0.1). The front
+        // hips (x' = 0.35, 0.05 m below the origin) stand over the highest ground, 0.035 m:
+        // z = 0.035 + 0.27 − (0.35·(−sin pitch) − 0.05·cos pitch); the front hips rise
+        // by 0.35·sin|pitch| < 0.035 m, so the rear ones stand higher above their ground.
         let robot = RobotDescription::reference();
         let p =
             driving_posture(&robot, &Pose2::new(0.0, 0.0, 0.0), 0.27, 0.7, |x, _| Some(0.1 * x))
                 .unwrap();
         let pitch = -0.7 * 0.1f64.atan();
         assert!((p.base_rpy[1] - pitch).abs() < 1e-12);
-        assert!((p.base_position[2] - (0.27 + 0.05 * pitch.cos())).abs() < 1e-12);
+        let z = 0.035 + 0.27 - (0.35 * -pitch.sin() - 0.05 * pitch.cos());
+        assert!((p.base_position[2] - z).abs() < 1e-12, "{} {z}", p.base_position[2]);
         assert!((p.feet[0][2] - 0.035).abs() < 1e-12 && (p.feet[2][2] + 0.035).abs() < 1e-12);
         // The joint targets put each wheel back on its foot.
         let q = leg_joint_targets(&robot, &p).unwrap();
@@ -300,6 +305,20 @@ mod tests {
             (x < 0.0).then_some(0.0)
         });
         assert_eq!(e.unwrap_err(), [0.35, 0.32]);
+    }
+
+    #[test]
+    fn a_wheel_on_a_bump_keeps_its_knee_within_limits() {
+        // Flat ground with a 4 cm bump under the front-left wheel only. The hip over the
+        // bump stands 0.27 m above it; by the mean ground it would stand 3 cm lower, its
+        // hip-to-ankle 6 cm, the knee folded past 2.9 rad.
+        let robot = RobotDescription::reference();
+        let bump = |x: f64, y: f64| Some(if x > 0.2 && y > 0.2 { 0.04 } else { 0.0 });
+        let p = driving_posture(&robot, &Pose2::new(0.0, 0.0, 0.0), 0.27, 0.7, bump).unwrap();
+        leg_joint_targets(&robot, &p).unwrap();
+        let mut mean = p;
+        mean.base_position[2] -= 0.03;
+        assert!(leg_joint_targets(&robot, &mean).is_err());
     }
 
     #[test]

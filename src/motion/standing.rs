@@ -220,11 +220,27 @@ impl StandingRule {
         let grounded = self.heights().any(|h| probes.iter().all(|p| p.distances_ok(h).is_ok()));
         if grounded {
             let swing_z = self.swing_z(robot, heights, pre[leg], post_foot);
-            // The swing at most 5 cm apart, ends included.
+            // The swing at most 5 cm apart, ends included, and where the foot passes
+            // closest under its hip (1 cm either side, the generator's spacing): the
+            // hip-to-ankle distance is convex along the straight swing, so the knee
+            // folds furthest there, between two 5 cm samples.
             let (a, b) = (pre[leg], post_foot);
-            let n = ((b[0] - a[0]).hypot(b[1] - a[1]) / SWING_SAMPLE_M).ceil().max(1.0) as usize;
-            for k in 0..=n {
-                let t = k as f64 / n as f64;
+            let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let n = (len / SWING_SAMPLE_M).ceil().max(1.0) as usize;
+            let hip = {
+                let h = robot.hips[leg];
+                let (s, c) = yaw.sin_cos();
+                [xy[0] + c * h[0] - s * h[1], xy[1] + s * h[0] + c * h[1]]
+            };
+            let closest = if len > 1e-9 {
+                ((hip[0] - a[0]) * (b[0] - a[0]) + (hip[1] - a[1]) * (b[1] - a[1])) / (len * len)
+            } else {
+                0.0
+            };
+            let fine = SWING_FINE_M / len.max(1e-9);
+            let mut ts: Vec<f64> = (0..=n).map(|k| k as f64 / n as f64).collect();
+            ts.extend([closest - fine, closest, closest + fine].map(|t| t.clamp(0.0, 1.0)));
+            for t in ts {
                 let mut feet = pre;
                 feet[leg] = [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, swing_z];
                 probes.push(probe(&feet));
@@ -289,6 +305,10 @@ pub struct StepStance {
 
 /// Spacing of the swing points [`StandingRule::step_heights`] checks, m.
 const SWING_SAMPLE_M: f64 = 0.05;
+
+/// Spacing of the extra swing points around the foot's closest pass under its hip, m:
+/// the motion generator's sample spacing (`motion::expand`).
+const SWING_FINE_M: f64 = 0.01;
 
 /// The cheap part of [`solve_legs`] for one set of feet at every height of the rule: the
 /// rotation and the feet in the base frame are computed once; lowering the base by δ

@@ -1,0 +1,231 @@
+//! One feasibility model for the planner and the step motion generator: what the robot
+//! can do where, asked cheaply by the planner and exactly by the generator, from the same
+//! functions, so that a path the planner returns is a path the generator can expand.
+//! (Nav2 keeps its collision checker apart from its planners in the same way.)
+//!
+//! **Driving** ([`DrivingCheck`]): the driving posture of Sec. VI-B at a pose
+//! ([`kinematics::driving_posture`]: the feet in the neutral footprint on the height map,
+//! the base pitched by 70 % of the slope and set by the highest foot) must be reachable by
+//! every leg with the standing rule's reach margin (sagittal IK within the joint limits),
+//! keep every thigh and shin clear of the terrain ([`StandingRule::legs_clear`] on the
+//! height map dilated by the legs' width), and keep the lumped CoM estimate
+//! ([`standing::com_estimate`]) inside the support polygon by the required margin.
+//!
+//! The generator checks this at every keyframe and at points 1 cm / 0.02 rad apart between
+//! them; the planner checks it once per lattice pose (memoised with the pose cost) against
+//! terrain dilated by [`SWEEP_CELLS`] more cells, which covers every point of the legs
+//! between two neighbouring lattice poses: a move of the 20-neighbourhood (at most
+//! √5 cells, 5.6 cm) or a turn of 2π/64 (4.6 cm at the farthest leg point, 0.47 m from the
+//! centre) brings no leg point farther than 2.8 cm from where it stood at one of the two
+//! ends.
+//!
+//! Stepping uses the standing rule of `motion::standing` (its step heights are what the
+//! planner's reach check and the generator's step candidates share).
+
+use crate::cost::CostMaps;
+use crate::geometry::Pose2;
+use crate::motion::kinematics::{self, Posture, PostureError, solve_legs};
+use crate::motion::standing::{self, StandingRule};
+use crate::params::Params;
+use crate::robot::RobotDescription;
+use crate::stability::stability_margin;
+use crate::terrain::HeightMap;
+
+/// Extra cells by which the planner's leg terrain is dilated beyond the generator's
+/// (`cost::LEG_TERRAIN_CELLS`): two cells (5 cm) ≥ the 2.8 cm a leg point moves away from
+/// both ends of a lattice edge (see the module docs).
+pub const SWEEP_CELLS: usize = 2;
+
+/// Why a pose is infeasible.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Infeasible {
+    /// A foot stands where the height map knows no ground.
+    #[error("no terrain height at ({x:.3}, {y:.3})")]
+    UnknownTerrain {
+        /// World x, m.
+        x: f64,
+        /// World y, m.
+        y: f64,
+    },
+    /// A leg cannot reach its foot, passes a joint limit or touches the terrain.
+    #[error(transparent)]
+    Posture(#[from] PostureError),
+    /// The CoM lies too close to the edge of the support polygon.
+    #[error("stability margin {margin_m:.3} m, {required_m} m required")]
+    Margin {
+        /// The margin, m.
+        margin_m: f64,
+        /// The required margin, m.
+        required_m: f64,
+    },
+}
+
+/// The driving-posture feasibility check (see the module docs).
+#[derive(Debug, Clone)]
+pub struct DrivingCheck {
+    robot: RobotDescription,
+    rule: StandingRule,
+    leg_height_m: f64,
+    min_margin_m: f64,
+}
+
+impl DrivingCheck {
+    /// The check with the paper's driving leg height and pitch fraction from `params`.
+    pub fn new(robot: &RobotDescription, params: &Params) -> Self {
+        Self::from_parts(
+            robot,
+            StandingRule::from_params(params),
+            params.driving_leg_height_m,
+            params.min_stability_margin_m,
+        )
+    }
+
+    /// The check from its parts: the standing rule (reach margin, leg clearance, pitch
+    /// fraction), the driving leg height and the required stability margin, m.
+    pub fn from_parts(
+        robot: &RobotDescription,
+        rule: StandingRule,
+        leg_height_m: f64,
+        min_margin_m: f64,
+    ) -> Self {
+        Self { robot: robot.clone(), rule, leg_height_m, min_margin_m }
+    }
+
+    /// The driving posture at `pose` on `heights`.
+    ///
+    /// # Errors
+    /// [`Infeasible::UnknownTerrain`] where a foot has no ground.
+    pub fn posture(&self, pose: &Pose2, heights: &HeightMap) -> Result<Posture, Infeasible> {
+        kinematics::driving_posture(
+            &self.robot,
+            pose,
+            self.leg_height_m,
+            self.rule.pitch_fraction,
+            |x, y| heights.height_at_cell(x, y),
+        )
+        .map_err(|[x, y]| Infeasible::UnknownTerrain { x, y })
+    }
+
+    /// Whether posture `p` is reachable (reach margin, joint limits), keeps every thigh
+    /// and shin clear of `leg_terrain`, and keeps the CoM estimate `min_margin_m` inside
+    /// the feet in contact; the joint angles if so.
+    ///
+    /// # Errors
+    /// The first [`Infeasible`] found.
+    pub fn posture_ok(
+        &self,
+        p: &Posture,
+        leg_terrain: &HeightMap,
+    ) -> Result<[[f64; 3]; 4], Infeasible> {
+        let joints = solve_legs(&self.robot, p, self.rule.reach_margin_m)?;
+        self.rule.legs_clear(&self.robot, leg_terrain, p, &joints)?;
+        let com = standing::com_estimate(&self.robot, p)?;
+        let support: Vec<[f64; 2]> =
+            (0..4).filter(|&i| p.contact[i]).map(|i| [p.feet[i][0], p.feet[i][1]]).collect();
+        let margin_m = stability_margin(&support, com);
+        if margin_m < self.min_margin_m {
+            return Err(Infeasible::Margin { margin_m, required_m: self.min_margin_m });
+        }
+        Ok(joints)
+    }
+
+    /// The standing posture of the standing rule ([`StandingRule::stand`]) in the neutral
+    /// footprint at `pose`, checked as [`Self::posture_ok`] does.
+    ///
+    /// # Errors
+    /// The first [`Infeasible`] found.
+    pub fn standing(
+        &self,
+        pose: &Pose2,
+        heights: &HeightMap,
+        leg_terrain: &HeightMap,
+    ) -> Result<Posture, Infeasible> {
+        let feet = self.posture(pose, heights)?.feet;
+        let (p, _) =
+            self.rule.stand(&self.robot, leg_terrain, feet, [pose.x, pose.y], pose.theta)?;
+        self.posture_ok(&p, leg_terrain)?;
+        Ok(p)
+    }
+
+    /// The planner's check of a neutral-footprint lattice pose: the robot can be there
+    /// in its driving posture or, failing that, standing tall in the neutral footprint
+    /// (the generator drives standing between close manoeuvres, and stands up where the
+    /// driving posture does not fit: see `motion::expand`), checked against the swept
+    /// leg terrain ([`CostMaps::swept_leg_terrain`]) so that every posture the generator
+    /// samples between this pose and a neighbour is feasible too.
+    ///
+    /// # Errors
+    /// The driving posture's [`Infeasible`] if neither fits.
+    pub fn lattice_pose(&self, maps: &CostMaps, pose: &Pose2) -> Result<(), Infeasible> {
+        let p = self.posture(pose, maps.heights())?;
+        match self.posture_ok(&p, maps.swept_leg_terrain()) {
+            Ok(_) => Ok(()),
+            Err(e) => self
+                .standing(pose, maps.heights(), maps.swept_leg_terrain())
+                .map(|_| ())
+                .map_err(|_| e),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn maps(f: impl Fn(f64, f64) -> f64) -> CostMaps {
+        let hm = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |i, j| {
+            f(-2.0 + (i as f64 + 0.5) * 0.025, -2.0 + (j as f64 + 0.5) * 0.025)
+        })
+        .unwrap();
+        CostMaps::build(&hm, &RobotDescription::reference(), &Params::default()).unwrap()
+    }
+
+    #[test]
+    fn flat_ground_is_feasible_everywhere_inside() {
+        let m = maps(|_, _| 0.0);
+        let c = DrivingCheck::new(&RobotDescription::reference(), &Params::default());
+        for k in 0..16 {
+            let pose = Pose2::new(0.1, -0.2, f64::from(k) * 0.4);
+            c.lattice_pose(&m, &pose).unwrap();
+        }
+    }
+
+    #[test]
+    fn a_doorway_passed_at_an_angle_is_a_leg_collision_the_foot_cost_misses() {
+        // A 1.02 m doorway in a 1 m wall (x ∈ [1.7, 1.9]). Turned 34° in it, every wheel
+        // pair keeps r_F = 0.12 m from the wall (finite foot cost, the paper's planner
+        // admits the pose), but the right rear leg's knee, bent toward the body centre,
+        // reaches over the wall: the pose a planned path once drove through and the
+        // motion generator rejected.
+        let robot = RobotDescription::reference();
+        let wall = |y: f64| crate::scenario::Primitive::Box {
+            center: [1.8, y],
+            size: [0.2, 1.5],
+            height: 1.0,
+            yaw_deg: 0.0,
+        };
+        let hm =
+            crate::terrain::rasterise(&[wall(1.26), wall(-1.26)], [0.0, -2.0], [3.5, 4.0], 0.025)
+                .unwrap();
+        let m = CostMaps::build(&hm, &robot, &Params::default()).unwrap();
+        let c = DrivingCheck::new(&robot, &Params::default());
+        let angled = Pose2::new(1.5625, -0.1875, 33.75f64.to_radians());
+        assert!(m.driving_pose_cost(&angled).finite().is_some());
+        match c.lattice_pose(&m, &angled) {
+            Err(Infeasible::Posture(PostureError::LegCollision { .. })) => {}
+            other => panic!("expected a leg collision, got {other:?}"),
+        }
+        // Square to the doorway, in its middle: through.
+        c.lattice_pose(&m, &Pose2::new(1.8, 0.0, 0.0)).unwrap();
+    }
+
+    #[test]
+    fn unknown_ground_under_a_foot_is_named() {
+        let m = maps(|x, _| if x > 0.0 { f64::NAN } else { 0.0 });
+        let c = DrivingCheck::new(&RobotDescription::reference(), &Params::default());
+        match c.lattice_pose(&m, &Pose2::new(0.0, 0.0, 0.0)) {
+            Err(Infeasible::UnknownTerrain { x, .. }) => assert!(x > 0.0),
+            other => panic!("expected unknown terrain, got {other:?}"),
+        }
+    }
+}
