@@ -36,6 +36,9 @@ use crate::terrain::HeightMap;
 /// both ends of a lattice edge (see the module docs).
 pub const SWEEP_CELLS: usize = 2;
 
+/// Clearance the base's underside keeps above the terrain under its circles, m.
+pub const BODY_CLEARANCE_M: f64 = 0.02;
+
 /// Why a pose is infeasible.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Infeasible {
@@ -50,6 +53,14 @@ pub enum Infeasible {
     /// A leg cannot reach its foot, passes a joint limit or touches the terrain.
     #[error(transparent)]
     Posture(#[from] PostureError),
+    /// The base's underside would not clear the terrain under its two circles (the
+    /// paper's body model, Sec. IV); `clearance` is negative when the terrain reaches
+    /// into the body.
+    #[error("base {clearance_m:.3} m above the terrain under it")]
+    BodyCollision {
+        /// Underside above the highest terrain under a circle, m.
+        clearance_m: f64,
+    },
     /// The CoM lies too close to the edge of the support polygon.
     #[error("stability margin {margin_m:.3} m, {required_m} m required")]
     Margin {
@@ -67,6 +78,7 @@ pub struct DrivingCheck {
     rule: StandingRule,
     leg_height_m: f64,
     min_margin_m: f64,
+    circle_radius_m: f64,
 }
 
 impl DrivingCheck {
@@ -77,18 +89,21 @@ impl DrivingCheck {
             StandingRule::from_params(params),
             params.driving_leg_height_m,
             params.min_stability_margin_m,
+            params.base_circle_radius_m,
         )
     }
 
     /// The check from its parts: the standing rule (reach margin, leg clearance, pitch
-    /// fraction), the driving leg height and the required stability margin, m.
+    /// fraction), the driving leg height, the required stability margin and the base
+    /// circles' radius, m.
     pub fn from_parts(
         robot: &RobotDescription,
         rule: StandingRule,
         leg_height_m: f64,
         min_margin_m: f64,
+        circle_radius_m: f64,
     ) -> Self {
-        Self { robot: robot.clone(), rule, leg_height_m, min_margin_m }
+        Self { robot: robot.clone(), rule, leg_height_m, min_margin_m, circle_radius_m }
     }
 
     /// The driving posture at `pose` on `heights`.
@@ -107,18 +122,21 @@ impl DrivingCheck {
     }
 
     /// Whether posture `p` is reachable (reach margin, joint limits), keeps every thigh
-    /// and shin clear of `leg_terrain`, and keeps the CoM estimate `min_margin_m` inside
-    /// the feet in contact; the joint angles if so.
+    /// and shin clear of `leg_terrain` and the base clear of the terrain under it
+    /// ([`Self::body_clear`]), and keeps the CoM estimate `min_margin_m` inside the feet
+    /// in contact; the joint angles if so.
     ///
     /// # Errors
     /// The first [`Infeasible`] found.
     pub fn posture_ok(
         &self,
         p: &Posture,
+        maps: &CostMaps,
         leg_terrain: &HeightMap,
     ) -> Result<[[f64; 3]; 4], Infeasible> {
         let joints = solve_legs(&self.robot, p, self.rule.reach_margin_m)?;
         self.rule.legs_clear(&self.robot, leg_terrain, p, &joints)?;
+        self.body_clear(p, maps)?;
         let com = standing::com_estimate(&self.robot, p)?;
         let support: Vec<[f64; 2]> =
             (0..4).filter(|&i| p.contact[i]).map(|i| [p.feet[i][0], p.feet[i][1]]).collect();
@@ -129,6 +147,32 @@ impl DrivingCheck {
         Ok(joints)
     }
 
+    /// Whether the base's underside (at hip level, `RobotDescription::base_bottom_z`)
+    /// stays [`BODY_CLEARANCE_M`] above the highest terrain under each of the paper's two
+    /// base circles (the cost client's disc maxima, `cost::body`): eq. 3 charges for
+    /// lifting the body over an obstacle, and this is where lifting no longer helps.
+    ///
+    /// # Errors
+    /// [`Infeasible::BodyCollision`], or unknown terrain under a circle.
+    pub fn body_clear(&self, p: &Posture, maps: &CostMaps) -> Result<(), Infeasible> {
+        let r = kinematics::rotation(p.base_rpy);
+        let z_under = self.robot.hips[0][2] + self.robot.base_bottom_z;
+        let hm = maps.heights();
+        for cx in self.robot.base_circle_centres_x(self.circle_radius_m) {
+            let w = kinematics::apply(&r, p.base_position, [cx, 0.0, z_under]);
+            let Some((i, j)) = hm.cell_of(w[0], w[1]) else {
+                return Err(Infeasible::UnknownTerrain { x: w[0], y: w[1] });
+            };
+            let Some(top) = maps.disc_max_layer().get(i, j) else {
+                return Err(Infeasible::UnknownTerrain { x: w[0], y: w[1] });
+            };
+            if w[2] - top < BODY_CLEARANCE_M {
+                return Err(Infeasible::BodyCollision { clearance_m: w[2] - top });
+            }
+        }
+        Ok(())
+    }
+
     /// The standing posture of the standing rule ([`StandingRule::stand`]) in the neutral
     /// footprint at `pose`, checked as [`Self::posture_ok`] does.
     ///
@@ -137,13 +181,13 @@ impl DrivingCheck {
     pub fn standing(
         &self,
         pose: &Pose2,
-        heights: &HeightMap,
+        maps: &CostMaps,
         leg_terrain: &HeightMap,
     ) -> Result<Posture, Infeasible> {
-        let feet = self.posture(pose, heights)?.feet;
+        let feet = self.posture(pose, maps.heights())?.feet;
         let (p, _) =
             self.rule.stand(&self.robot, leg_terrain, feet, [pose.x, pose.y], pose.theta)?;
-        self.posture_ok(&p, leg_terrain)?;
+        self.posture_ok(&p, maps, leg_terrain)?;
         Ok(p)
     }
 
@@ -158,12 +202,11 @@ impl DrivingCheck {
     /// The driving posture's [`Infeasible`] if neither fits.
     pub fn lattice_pose(&self, maps: &CostMaps, pose: &Pose2) -> Result<(), Infeasible> {
         let p = self.posture(pose, maps.heights())?;
-        match self.posture_ok(&p, maps.swept_leg_terrain()) {
+        match self.posture_ok(&p, maps, maps.swept_leg_terrain()) {
             Ok(_) => Ok(()),
-            Err(e) => self
-                .standing(pose, maps.heights(), maps.swept_leg_terrain())
-                .map(|_| ())
-                .map_err(|_| e),
+            Err(e) => {
+                self.standing(pose, maps, maps.swept_leg_terrain()).map(|_| ()).map_err(|_| e)
+            }
         }
     }
 }

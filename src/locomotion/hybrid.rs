@@ -87,6 +87,7 @@ use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, e
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{StepBound, StepBoundParams};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
+use super::reachability::BaseRegions;
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
@@ -210,6 +211,8 @@ pub struct HybridConfig {
     pub driving_leg_height_m: f64,
     /// Smallest stability margin of a posture, m (the generator's requirement).
     pub min_stability_margin_m: f64,
+    /// Radius of the base's two circles (Sec. IV), m.
+    pub base_circle_radius_m: f64,
 }
 
 impl HybridConfig {
@@ -235,6 +238,7 @@ impl HybridConfig {
             max_footprints: 65_536,
             driving_leg_height_m: params.driving_leg_height_m,
             min_stability_margin_m: params.min_stability_margin_m,
+            base_circle_radius_m: params.base_circle_radius_m,
         }
     }
 }
@@ -269,6 +273,11 @@ pub struct ManoeuvreStats {
 pub struct HybridGraph<'c> {
     maps: &'c CostMaps,
     driving: DrivingGraph<FeasibleDriving<'c>>,
+    /// The shared feasibility model (`feasibility`): body clearance of standing states.
+    feasibility: DrivingCheck,
+    /// Base cells that can still reach the goal (`reachability`): an infinite heuristic
+    /// elsewhere proves "no path" without searching.
+    regions: BaseRegions,
     config: HybridConfig,
     lattice: Lattice,
     /// Neutral foot positions in the base frame (x', y'), FL, FR, RL, RR.
@@ -372,23 +381,31 @@ impl<'c> HybridGraph<'c> {
         let near = near_obstacle_layer(maps, config.step_obstacle_distance_m);
         let t0 = Instant::now();
         let step_bound = build_step_bound(maps, &near, &config, &lattice, goal);
+        let regions = BaseRegions::build(
+            maps,
+            robot,
+            &lattice,
+            config.base_circle_radius_m,
+            (goal.i, goal.j),
+        );
         let heuristic_setup = t0.elapsed();
+        let feasibility = DrivingCheck::from_parts(
+            robot,
+            config.standing,
+            config.driving_leg_height_m,
+            config.min_stability_margin_m,
+            config.base_circle_radius_m,
+        );
         Ok(Self {
             maps,
             driving: DrivingGraph::new(
-                FeasibleDriving {
-                    maps,
-                    check: DrivingCheck::from_parts(
-                        robot,
-                        config.standing,
-                        config.driving_leg_height_m,
-                        config.min_stability_margin_m,
-                    ),
-                },
+                FeasibleDriving { maps, check: feasibility.clone() },
                 lattice,
                 config.driving,
                 goal,
             ),
+            feasibility,
+            regions,
             near,
             config,
             lattice,
@@ -557,6 +574,7 @@ impl<'c> HybridGraph<'c> {
             .standing
             .stand(&self.robot, self.maps.leg_terrain(), world, [pose.x, pose.y], pose.theta)
             .ok()?;
+        self.feasibility.body_clear(&p, self.maps).ok()?;
         let hips = hips_in_world(&self.robot, &p);
         Some(std::array::from_fn(|k| hips[k][2] - world[k][2]))
     }
@@ -1136,6 +1154,9 @@ impl SearchGraph for HybridGraph<'_> {
     /// step bound Σ_k S_k of the four feet (`heuristic` module): consistent on every
     /// manoeuvre (see the module docs of both).
     fn heuristic(&self, s: LatticeState) -> Cost {
+        if !self.regions.reachable(s.i, s.j) {
+            return Cost::INFINITY;
+        }
         let h = self.driving.heuristic(s);
         let Some(o) = self.footprints.get(s.footprint) else {
             return h;

@@ -11,6 +11,9 @@
 //! - [`heuristic`]: the informed part of the hybrid heuristic — a lower bound on the step
 //!   costs (eq. 5) each foot still needs, and the foot-offset potential; built once per
 //!   graph.
+//! - [`reachability`]: base cells where the body and legs fit at all, and their
+//!   connected regions: states outside the goal's region get an infinite heuristic, so
+//!   closed rooms and doorways narrower than the robot are "no path" at once.
 //! - [`hybrid`]: the full hybrid graph — driving plus abstract steps, base shifts and
 //!   single-foot moves (Sec. V), with their costs C_S (eq. 5), C_BS and C_FM (eq. 6).
 
@@ -20,6 +23,7 @@ pub mod heuristic;
 pub mod hybrid;
 pub mod lattice;
 pub mod orientation;
+pub mod reachability;
 
 #[cfg(test)]
 mod tests;

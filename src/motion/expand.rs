@@ -69,6 +69,8 @@ pub struct MotionOptions {
     pub standing: StandingRule,
     /// Driving leg height (Sec. VI-B), m.
     pub driving_leg_height_m: f64,
+    /// Radius of the base's two circles (Sec. IV), m.
+    pub base_circle_radius_m: f64,
     /// Largest base roll, rad.
     pub max_roll_rad: f64,
     /// Largest stabilising base shift, m.
@@ -98,6 +100,7 @@ impl MotionOptions {
             min_margin_m: params.min_stability_margin_m,
             standing: StandingRule::from_params(params),
             driving_leg_height_m: params.driving_leg_height_m,
+            base_circle_radius_m: params.base_circle_radius_m,
             max_roll_rad: 0.2,
             max_base_shift_m: 0.2,
             max_wheel_to_centre_m: params.max_wheel_to_centre_m,
@@ -755,6 +758,7 @@ pub fn expand_path(
         options.standing,
         options.driving_leg_height_m,
         options.min_margin_m,
+        options.base_circle_radius_m,
     );
     let special = |k: PathKind| !matches!(k, PathKind::Start | PathKind::Drive | PathKind::Turn);
     let mut standing = false;
@@ -785,7 +789,7 @@ pub fn expand_path(
                         };
                         let p = ex.driving(&pose)?;
                         // Lower only where the driving posture fits (`feasibility`).
-                        if check.posture_ok(&p, maps.leg_terrain()).is_ok() {
+                        if check.posture_ok(&p, maps, maps.leg_terrain()).is_ok() {
                             ex.push(el.kind, &[(Phase::Lower, None, p)])?;
                             standing = false;
                         }
@@ -795,7 +799,7 @@ pub fn expand_path(
                 // folded past its limit), drive standing, as the planner's feasibility
                 // check allowed (`feasibility::DrivingCheck::lattice_pose`).
                 if !standing
-                    && check.posture_ok(&ex.driving(&el.pose)?, maps.leg_terrain()).is_err()
+                    && check.posture_ok(&ex.driving(&el.pose)?, maps, maps.leg_terrain()).is_err()
                 {
                     ex.stand_up(el.kind)?;
                     standing = true;

@@ -77,11 +77,15 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
         if let Some(id) = engine.store.get_or_insert(&*engine.graph, start) {
             let n = engine.store.get_mut(id);
             n.g = Cost::ZERO;
-            n.set_open(true);
             let (h, goal) = (n.h, n.is_goal());
-            engine.open.push(Entry { key: weighted_key(Cost::ZERO, h, eps), h: h.0, node: id });
             if goal {
                 engine.goal = Some(id);
+            }
+            // An infinite heuristic proves that no path leaves the start: OPEN stays
+            // empty and the search ends at once with no path.
+            if goal || !h.is_infinite() {
+                n.set_open(true);
+                engine.open.push(Entry { key: weighted_key(Cost::ZERO, h, eps), h: h.0, node: id });
             }
         }
         engine
@@ -150,6 +154,10 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 };
                 let best_goal_g = self.goal.map_or(Cost::INFINITY, |b| self.store.get(b).g);
                 let tn = self.store.get_mut(tid);
+                // An infinite (admissible) heuristic: the goal cannot be reached from t.
+                if tn.h.is_infinite() {
+                    continue;
+                }
                 // line 07: if g(s') > g(s) + c(s, s')
                 if ng >= tn.g {
                     continue;
