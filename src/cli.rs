@@ -465,8 +465,9 @@ fn print_check_table(report: &jobs::check::CheckReport) {
     }
     line("total", &report.total);
     say!(
-        "{} scenarios{} on {} worker{} in {:.1} s wall",
+        "{} scenario{}{} on {} worker{} in {:.1} s wall",
         report.total.cases,
+        if report.total.cases == 1 { "" } else { "s" },
         report.shard.map_or(String::new(), |s| format!(" (shard {s})")),
         report.jobs,
         if report.jobs == 1 { "" } else { "s" },

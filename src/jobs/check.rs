@@ -460,13 +460,17 @@ pub struct Finished<'a> {
     pub row: &'a CheckRow,
 }
 
-/// An error and its sources, joined by ": ".
+/// An error and its sources, joined by ": "; a source whose text the message already
+/// ends with (errors that print their cause) is not repeated.
 fn chain(e: &dyn std::error::Error) -> String {
     let mut s = e.to_string();
     let mut cur = e.source();
     while let Some(c) = cur {
-        s.push_str(": ");
-        s.push_str(&c.to_string());
+        let text = c.to_string();
+        if !s.ends_with(&text) {
+            s.push_str(": ");
+            s.push_str(&text);
+        }
         cur = c.source();
     }
     s
@@ -852,6 +856,20 @@ mod tests {
                 static_violation_exceeded: 1,
             }
         );
+    }
+
+    #[test]
+    fn error_chains_name_each_cause_once() {
+        #[derive(Debug, thiserror::Error)]
+        enum E {
+            #[error("outer: {0}")]
+            Prints(#[source] std::io::Error),
+            #[error("outer")]
+            Hides(#[source] std::io::Error),
+        }
+        let io = || std::io::Error::other("inner");
+        assert_eq!(chain(&E::Prints(io())), "outer: inner");
+        assert_eq!(chain(&E::Hides(io())), "outer: inner");
     }
 
     #[test]
