@@ -353,8 +353,7 @@ fn check(
     let width = files.len().to_string().len();
     let report = check::run(&files, &opts, &mut |f| {
         use std::io::Write as _;
-        let _ = writeln!(
-            std::io::stderr(),
+        let line = format!(
             "[{:>width$}/{}] {:<24} {:<7} {:>7.1} s  {}",
             f.done,
             f.total,
@@ -363,6 +362,7 @@ fn check(
             f.row.wall_time_s,
             f.row.failure_kind().unwrap_or("")
         );
+        let _ = writeln!(std::io::stderr(), "{}", line.trim_end());
     })
     .map_err(check_error)?;
     if json {
