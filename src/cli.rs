@@ -115,12 +115,25 @@ pub enum Command {
         #[command(flatten)]
         model: ModelArgs,
     },
-    /// Run scenarios in closed loop and print a table; exit non-zero if any fails.
+    /// Run a suite of scenarios in closed loop on worker threads and print a table of
+    /// results with totals per class; exit 0 if all pass, 1 if any fails, 2 if any is
+    /// invalid.
     Check {
-        /// Scenario files (default: every scenarios/*.toml).
-        scenarios: Vec<PathBuf>,
+        /// Scenario files or directories (every *.toml below them, recursively); sorted
+        /// and de-duplicated. Default: every scenarios/*.toml of the repository.
+        #[arg(value_name = "PATH")]
+        paths: Vec<PathBuf>,
         #[command(flatten)]
         planner: PlannerArgs,
+        /// Worker threads, each running whole scenarios (default: the available
+        /// parallelism). Results do not depend on it.
+        #[arg(long, value_name = "N")]
+        jobs: Option<usize>,
+        /// Run only shard K of N: the files whose 0-based index i in the sorted suite has
+        /// i mod N = K-1 (like cargo-nextest's --partition count:K/N). N jobs of a CI
+        /// matrix or a cluster job array, K = 1..N, run every file exactly once.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
         /// Print the results as JSON.
         #[arg(long)]
         json: bool,
@@ -302,16 +315,164 @@ fn robot(model: &std::path::Path) -> anyhow::Result<crate::robot::RobotDescripti
     Ok(crate::sim::Simulation::robot_only(model)?.robot().clone())
 }
 
-/// Every `scenarios/*.toml` of the repository, sorted.
-fn all_scenarios() -> anyhow::Result<Vec<PathBuf>> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .with_context(|| format!("listing {}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
-    Ok(v)
+fn check_error(e: jobs::check::CheckError) -> anyhow::Error {
+    use jobs::check::CheckError as E;
+    match e {
+        E::BadShard { .. } | E::NoWorkers | E::Io { .. } | E::EmptyDirectory { .. } => {
+            anyhow::Error::new(BadInput(e.to_string()))
+        }
+        E::Spawn(_) => anyhow::Error::new(e),
+    }
+}
+
+/// `momaro check`: the suite's rows on stderr as they finish, then the table (or JSON) in
+/// the suite's order on stdout.
+fn check(
+    paths: &[PathBuf],
+    planner: &PlannerArgs,
+    jobs: Option<usize>,
+    shard: Option<&str>,
+    json: bool,
+    model: PathBuf,
+) -> anyhow::Result<bool> {
+    use jobs::check;
+    let shard = shard.map(str::parse::<check::Shard>).transpose().map_err(check_error)?;
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let files = if paths.is_empty() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+        check::repository_scenarios(&dir)
+    } else {
+        check::discover(paths)
+    }
+    .map_err(check_error)?;
+    let opts = check::CheckOptions {
+        run: jobs::run::RunOptions::new(planner.options(), model),
+        jobs,
+        shard,
+    };
+    let width = files.len().to_string().len();
+    let report = check::run(&files, &opts, &mut |f| {
+        use std::io::Write as _;
+        let line = format!(
+            "[{:>width$}/{}] {:<24} {:<7} {:>7.1} s  {}",
+            f.done,
+            f.total,
+            f.row.scenario,
+            f.row.verdict().to_string(),
+            f.row.wall_time_s,
+            f.row.failure_kind().unwrap_or("")
+        );
+        let _ = writeln!(std::io::stderr(), "{}", line.trim_end());
+    })
+    .map_err(check_error)?;
+    if json {
+        print_json(&report)?;
+    } else {
+        print_check_table(&report);
+    }
+    if report.any_invalid() {
+        return Err(anyhow::Error::new(BadInput(format!(
+            "{} of {} scenarios are invalid input",
+            report.total.invalid, report.total.cases
+        ))));
+    }
+    Ok(report.all_passed())
+}
+
+fn print_check_table(report: &jobs::check::CheckReport) {
+    use jobs::check::RowOutcome;
+    let name_w = report.rows.iter().map(|r| r.scenario.len()).max().unwrap_or(0).max(8);
+    let class_w = report.classes.keys().map(String::len).max().unwrap_or(0).max(5);
+    say!(
+        "{:<name_w$}  {:<class_w$}  {:<7}  {:<19}  {:>10}  {:>8}  {:>8}  {:<6}  {:>7}  {:>6}  {:>7}",
+        "scenario",
+        "class",
+        "result",
+        "failure",
+        "goal err m",
+        "margin m",
+        "static s",
+        "tipped",
+        "steps",
+        "sim s",
+        "wall s"
+    );
+    for row in &report.rows {
+        let head = format!(
+            "{:<name_w$}  {:<class_w$}  {:<7}",
+            row.scenario,
+            row.class_key(),
+            row.verdict().to_string()
+        );
+        match &row.outcome {
+            RowOutcome::Ran { summary: s, .. } => {
+                let kind = row.failure_kind().unwrap_or("-");
+                let margin = if s.min_stability_margin_m.is_finite() {
+                    format!("{:.3}", s.min_stability_margin_m)
+                } else {
+                    "-".to_owned()
+                };
+                say!(
+                    "{head}  {:<19}  {:>10.3}  {:>8}  {:>8.3}  {:<6}  {:>7}  {:>6.1}  {:>7.1}",
+                    kind,
+                    s.goal_position_error_m,
+                    margin,
+                    s.static_violation_s,
+                    if s.tipped { "yes" } else { "no" },
+                    format!("{}/{}", s.steps_executed, s.steps_planned),
+                    s.sim_time_s,
+                    row.wall_time_s
+                );
+            }
+            RowOutcome::Error { message } | RowOutcome::Invalid { message } => {
+                say!("{head}  {message}");
+            }
+        }
+    }
+    say!("");
+    say!(
+        "{:<class_w$}  {:>5}  {:>6}  {:>6}  {:>6}  {:>7}  {:>7}  {:>7}  {:>10}  {:>6}  {:>12}",
+        "class",
+        "cases",
+        "passed",
+        "failed",
+        "errors",
+        "invalid",
+        "reached",
+        "no path",
+        "motion gen",
+        "tipped",
+        "static > max"
+    );
+    let line = |name: &str, t: &jobs::check::Totals| {
+        say!(
+            "{:<class_w$}  {:>5}  {:>6}  {:>6}  {:>6}  {:>7}  {:>7}  {:>7}  {:>10}  {:>6}  {:>12}",
+            name,
+            t.cases,
+            t.passed,
+            t.failed,
+            t.errors,
+            t.invalid,
+            t.reached_goal,
+            t.no_path,
+            t.motion_generation,
+            t.tipped,
+            t.static_violation_exceeded
+        );
+    };
+    for (class, t) in &report.classes {
+        line(class, t);
+    }
+    line("total", &report.total);
+    say!(
+        "{} scenario{}{} on {} worker{} in {:.1} s wall",
+        report.total.cases,
+        if report.total.cases == 1 { "" } else { "s" },
+        report.shard.map_or(String::new(), |s| format!(" (shard {s})")),
+        report.jobs,
+        if report.jobs == 1 { "" } else { "s" },
+        report.wall_time_s
+    );
 }
 
 fn load(path: &std::path::Path) -> anyhow::Result<Scenario> {
@@ -563,56 +724,8 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             }
             Ok(s.passed)
         }
-        Command::Check { scenarios, planner, json, model } => {
-            let files = if scenarios.is_empty() { all_scenarios()? } else { scenarios };
-            let mut rows = Vec::new();
-            let mut all_passed = true;
-            if !json {
-                say!(
-                    "{:<16} {:<7} {:>11} {:>11} {:>9} {:>9}",
-                    "scenario",
-                    "result",
-                    "goal err m",
-                    "margin m",
-                    "sim s",
-                    "wall s"
-                );
-            }
-            for file in &files {
-                let sc = load(file)?;
-                let opts = jobs::run::RunOptions::new(planner.options(), model.model.clone());
-                let row = match jobs::run::run(&sc, &opts) {
-                    Ok(s) => {
-                        if !json {
-                            say!(
-                                "{:<16} {:<7} {:>11.3} {:>11.3} {:>9.1} {:>9.1}",
-                                s.scenario,
-                                if s.passed { "PASS" } else { "FAIL" },
-                                s.goal_position_error_m,
-                                s.min_stability_margin_m,
-                                s.sim_time_s,
-                                s.wall_time_s
-                            );
-                        }
-                        all_passed &= s.passed;
-                        serde_json::to_value(&s).context("serialising")?
-                    }
-                    Err(e) => {
-                        // The whole cause chain: "step motion generation: path element …".
-                        let e = format!("{:#}", run_error(e));
-                        if !json {
-                            say!("{:<16} {:<7} {e}", sc.name, "ERROR");
-                        }
-                        all_passed = false;
-                        serde_json::json!({ "scenario": sc.name, "passed": false, "error": e })
-                    }
-                };
-                rows.push(row);
-            }
-            if json {
-                print_json(&rows)?;
-            }
-            Ok(all_passed)
+        Command::Check { paths, planner, jobs, shard, json, model } => {
+            check(&paths, &planner, jobs, shard.as_deref(), json, model.model)
         }
         Command::Bench(BenchCommand::Plan {
             scenario,

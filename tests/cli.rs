@@ -284,3 +284,96 @@ fn run_steps_up_where_the_ramp_is_far() {
     assert_eq!(v["steps_executed"].as_u64(), Some(planned));
     assert_eq!(v["tipped"], false);
 }
+
+/// `check --json` of `files` with `jobs` workers: exit code and the report.
+fn check_json(files: &[&str], extra: &[&str]) -> (Option<i32>, serde_json::Value, String) {
+    let mut args = vec!["check", "--final-epsilon", "3", "--time-limit", "300", "--json"];
+    args.extend_from_slice(extra);
+    args.extend_from_slice(files);
+    let out = momaro(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let v = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("stdout is not JSON ({e}): {stderr}"));
+    (out.status.code(), v, stderr)
+}
+
+/// `v` without its wall-clock fields, at any depth.
+fn without_timing(v: &serde_json::Value) -> serde_json::Value {
+    match v {
+        serde_json::Value::Object(m) => m
+            .iter()
+            .filter(|(k, _)| {
+                !matches!(k.as_str(), "wall_time_s" | "real_time_factor" | "planning_time_s")
+            })
+            .map(|(k, v)| (k.clone(), without_timing(v)))
+            .collect(),
+        serde_json::Value::Array(a) => a.iter().map(without_timing).collect(),
+        other => other.clone(),
+    }
+}
+
+#[test]
+fn check_rows_do_not_depend_on_the_worker_count() {
+    let flat = common::root().join("scenarios/flat.toml");
+    let poles = common::root().join("scenarios/poles.toml");
+    // Given in reverse: the rows come in path order.
+    let files = [poles.to_str().unwrap(), flat.to_str().unwrap()];
+    let (code1, one, stderr1) = check_json(&files, &["--jobs", "1"]);
+    assert_eq!(code1, Some(0), "{stderr1}\n{one:#}");
+    let (code2, two, stderr2) = check_json(&files, &["--jobs", "2"]);
+    assert_eq!(code2, Some(0), "{stderr2}\n{two:#}");
+    assert_eq!((one["jobs"].as_u64(), two["jobs"].as_u64()), (Some(1), Some(2)));
+    assert_eq!(one["shard"], serde_json::Value::Null);
+    let names: Vec<_> = one["rows"]
+        .as_array()
+        .expect("rows")
+        .iter()
+        .map(|r| r["scenario"].as_str().unwrap_or_default().to_owned())
+        .collect();
+    assert_eq!(names, ["flat", "poles"]);
+    for r in one["rows"].as_array().expect("rows") {
+        assert_eq!(r["result"], "pass", "{r:#}");
+        assert_eq!(r["class"], serde_json::Value::Null);
+        assert!(r["path"].as_str().is_some_and(|p| p.ends_with(".toml")), "{r:#}");
+    }
+    assert_eq!(without_timing(&one["rows"]), without_timing(&two["rows"]));
+    assert_eq!(one["total"], two["total"]);
+    assert_eq!(one["total"]["cases"], 2);
+    assert_eq!(one["total"]["passed"], 2);
+    assert_eq!(one["classes"]["-"], one["total"]);
+    // One progress line per scenario on stderr.
+    assert_eq!(stderr2.lines().filter(|l| l.starts_with('[')).count(), 2, "{stderr2}");
+}
+
+#[test]
+fn check_shard_out_of_range_or_malformed_is_bad_input() {
+    let flat = common::root().join("scenarios/flat.toml");
+    for bad in ["0/2", "3/2", "1/0", "two/3", "1"] {
+        let out = momaro(&["check", "--shard", bad, flat.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {stderr}");
+        assert!(stderr.contains("--shard") && !stderr.contains("panicked"), "{bad}: {stderr}");
+    }
+}
+
+#[test]
+fn check_reports_an_invalid_file_as_a_row_and_runs_the_rest() {
+    let dir = common::temp_dir("check_invalid");
+    std::fs::write(dir.join("broken.toml"), GOOD.replace("x = 2.0", "x = 20.0")).unwrap();
+    std::fs::write(dir.join("notes.txt"), "not a scenario").unwrap();
+    let flat = common::root().join("scenarios/flat.toml");
+    let (code, v, stderr) =
+        check_json(&[dir.to_str().unwrap(), flat.to_str().unwrap()], &["--shard", "1/1"]);
+    assert_eq!(code, Some(2), "{stderr}\n{v:#}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(v["shard"], serde_json::json!([1, 1]));
+    let rows = v["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 2, "{v:#}");
+    let broken = rows.iter().find(|r| r["scenario"] == "broken").expect("broken row");
+    assert_eq!(broken["result"], "invalid");
+    let msg = broken["failure"].as_str().unwrap_or_default();
+    assert!(msg.contains("broken.toml") && msg.contains("goal"), "{msg}");
+    let flat = rows.iter().find(|r| r["scenario"] == "flat").expect("flat row");
+    assert_eq!(flat["result"], "pass", "{flat:#}");
+    assert_eq!((v["total"]["invalid"].as_u64(), v["total"]["passed"].as_u64()), (Some(1), Some(1)));
+}

@@ -2,6 +2,7 @@
 //! tests call exactly what users run.
 
 pub mod bench;
+pub mod check;
 pub mod costmap;
 pub mod detailed;
 pub mod plan;
