@@ -244,9 +244,7 @@ impl StabilityMonitor {
         let memory = self.limits.support_memory_s + 1e-9;
         let contacts: Vec<[f64; 2]> = (0..8)
             .filter_map(|k| {
-                near[k].or(self.last_touch[k]
-                    .filter(|(t, _)| time - t <= memory)
-                    .map(|(_, p)| p))
+                near[k].or(self.last_touch[k].filter(|(t, _)| time - t <= memory).map(|(_, p)| p))
             })
             .collect();
         StabilitySample {
@@ -383,7 +381,12 @@ mod tests {
         v
     }
 
-    fn level(m: &mut StabilityMonitor, t: f64, com: [f64; 2], w: &[WheelReading]) -> StabilitySample {
+    fn level(
+        m: &mut StabilityMonitor,
+        t: f64,
+        com: [f64; 2],
+        w: &[WheelReading],
+    ) -> StabilitySample {
         let s = m.sample(t, [com[0], com[1], 0.5], w, [0.0, 0.0], 0.0, Vec::new());
         m.record(&s);
         s

@@ -302,8 +302,9 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
     let res = f.params.grid_resolution_m;
     if res.is_finite() && res > 0.0 {
         let pad = 2.0 * f.params.r_n_m;
-        let cells = ((m.x_max - m.x_min + pad) / res).ceil() * ((m.y_max - m.y_min + pad) / res).ceil();
-        if !(cells <= MAX_MAP_CELLS) {
+        let cells =
+            ((m.x_max - m.x_min + pad) / res).ceil() * ((m.y_max - m.y_min + pad) / res).ceil();
+        if cells.is_nan() || cells > MAX_MAP_CELLS {
             return Err((
                 "map".into(),
                 format!(
@@ -529,7 +530,8 @@ mod tests {
     #[test]
     fn a_map_too_large_to_allocate_names_map_and_its_cells() {
         // 1 km x 1 km at 2.5 cm: 1.6e9 cells.
-        let text = GOOD.replace("x_max = 5.0", "x_max = 999.0").replace("y_max = 2.0", "y_max = 998.0");
+        let text =
+            GOOD.replace("x_max = 5.0", "x_max = 999.0").replace("y_max = 2.0", "y_max = 998.0");
         match parse(&text) {
             Err(ScenarioError::Invalid { field, reason, .. }) => {
                 assert_eq!(field, "map");
@@ -538,7 +540,8 @@ mod tests {
             other => panic!("expected an invalid map, got {other:?}"),
         }
         // 49 m x 49 m is fine.
-        let text = GOOD.replace("x_max = 5.0", "x_max = 48.0").replace("y_max = 2.0", "y_max = 47.0");
+        let text =
+            GOOD.replace("x_max = 5.0", "x_max = 48.0").replace("y_max = 2.0", "y_max = 47.0");
         parse(&text).unwrap();
     }
 
@@ -549,7 +552,10 @@ mod tests {
         assert_eq!(s.expect.outcome, Outcome::NoPath);
         assert_eq!(s.class.as_deref(), Some("stairs"));
         let e = parse(&format!("{GOOD}\n[expect]\noutcome = \"maybe\"\n")).unwrap_err();
-        assert!(matches!(e, ScenarioError::Parse { .. }) && e.to_string().contains("outcome"), "{e}");
+        assert!(
+            matches!(e, ScenarioError::Parse { .. }) && e.to_string().contains("outcome"),
+            "{e}"
+        );
         assert_eq!(field_of(&format!("class = \"a b\"\n{GOOD}")), "class");
         assert_eq!(
             field_of(&format!("{GOOD}\n[expect]\nmax_static_violation_s = -1\n")),
