@@ -3,6 +3,7 @@
 
 use crate::control::wheels::Twist;
 use crate::jobs;
+use crate::scenario::generate::Class;
 use crate::scenario::{Scenario, ScenarioError};
 use anyhow::Context as _;
 use clap::{Args, Parser, Subcommand};
@@ -140,6 +141,27 @@ pub enum Command {
         #[command(flatten)]
         model: ModelArgs,
     },
+    /// Write seeded random scenarios (eight classes of course) into a directory; each is
+    /// checked to load and to let the robot stand at its start and goal.
+    Generate {
+        /// Seed of the first case; case i uses SEED + i, so each file is reproducible alone.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Number of cases; without --class they cycle through the classes.
+        #[arg(long, default_value_t = 8)]
+        count: usize,
+        /// Directory to write into (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Only this class of course.
+        #[arg(long, value_name = "CLASS", value_parser = class_parser())]
+        class: Option<Class>,
+        /// Print the summary as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
     /// Write the URDF of the robot, generated from the MJCF model.
     Urdf {
         /// Output file (default: standard output).
@@ -240,6 +262,12 @@ pub enum BenchCommand {
         #[command(flatten)]
         model: ModelArgs,
     },
+}
+
+/// `--class`: one of the generator's class names (listed by `--help`).
+fn class_parser() -> impl clap::builder::TypedValueParser<Value = Class> {
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(Class::NAMES).try_map(|s| s.parse::<Class>())
 }
 
 fn parse_noise(s: &str) -> Result<jobs::run::PoseNoise, String> {
@@ -820,6 +848,38 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                     b.controlled_step_us
                 );
                 say!("controller+monitor  {:.1} % of a step", b.overhead_fraction * 100.0);
+            }
+            Ok(true)
+        }
+        Command::Generate { seed, count, out, class, json, model } => {
+            let opts = jobs::generate::GenerateOptions { seed, count, out_dir: out, class };
+            if count == 0 {
+                // Before the model loads: bad input is reported as such even without it.
+                return Err(anyhow::Error::new(BadInput(
+                    "invalid option `count`: must be at least 1".into(),
+                )));
+            }
+            let summary =
+                jobs::generate::run(&opts, &robot(&model.model)?).map_err(|e| match e {
+                    jobs::generate::GenerateJobError::BadOption { .. } => {
+                        anyhow::Error::new(BadInput(e.to_string()))
+                    }
+                    other => anyhow::Error::new(other).context("generate"),
+                })?;
+            if json {
+                print_json(&summary)?;
+            } else {
+                for f in &summary.files {
+                    say!("wrote {}  {}", f.path.display(), f.description);
+                }
+                let counts: Vec<String> =
+                    summary.per_class.iter().map(|c| format!("{} {}", c.class, c.count)).collect();
+                say!(
+                    "{} files in {} ({})",
+                    summary.files.len(),
+                    summary.out_dir.display(),
+                    counts.join(", ")
+                );
             }
             Ok(true)
         }

@@ -15,6 +15,7 @@ pub mod motion;
 pub mod params;
 pub mod planner;
 pub mod progress;
+pub mod rng;
 pub mod robot;
 pub mod scenario;
 pub mod sim;

@@ -377,3 +377,69 @@ fn check_reports_an_invalid_file_as_a_row_and_runs_the_rest() {
     assert_eq!(flat["result"], "pass", "{flat:#}");
     assert_eq!((v["total"]["invalid"].as_u64(), v["total"]["passed"].as_u64()), (Some(1), Some(1)));
 }
+
+#[test]
+fn generate_writes_one_loadable_file_per_class_and_repeats_byte_for_byte() {
+    let dirs = [common::temp_dir("generate_a"), common::temp_dir("generate_b")];
+    for dir in &dirs {
+        let out =
+            momaro(&["generate", "--seed", "1", "--count", "8", "--out", dir.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    let mut names: Vec<String> = std::fs::read_dir(&dirs[0])
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names.len(), 8, "{names:?}");
+    let mut classes = Vec::new();
+    for name in &names {
+        let path = dirs[0].join(name);
+        let s = momaro::scenario::Scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let class = s.class.clone().expect("a class");
+        assert!(name.starts_with(&format!("{class}_0000")), "{name}");
+        classes.push(class);
+        let again = std::fs::read(dirs[1].join(name)).expect("the second run wrote it too");
+        assert_eq!(std::fs::read(&path).unwrap(), again, "{name} differs between runs");
+    }
+    classes.sort();
+    let mut all: Vec<String> =
+        momaro::scenario::generate::Class::NAMES.iter().map(|s| s.to_string()).collect();
+    all.sort();
+    assert_eq!(classes, all);
+    // The JSON summary counts one file per class.
+    let out = momaro(&[
+        "generate",
+        "--seed",
+        "1",
+        "--count",
+        "8",
+        "--out",
+        dirs[1].to_str().unwrap(),
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    assert_eq!(v["files"].as_array().map(Vec::len), Some(8));
+    let per_class = v["per_class"].as_array().expect("per_class");
+    assert_eq!(per_class.len(), 8);
+    assert!(per_class.iter().all(|c| c["count"] == 1), "{v:#}");
+}
+
+#[test]
+fn generate_rejects_bad_input_with_exit_code_2() {
+    let dir = common::temp_dir("generate_bad");
+    let d = dir.to_str().unwrap();
+    for args in [
+        vec!["generate", "--count", "0", "--out", d],
+        vec!["generate", "--class", "ladder", "--out", d],
+        vec!["generate", "--seed", "18446744073709551615", "--count", "2", "--out", d],
+    ] {
+        let out = momaro(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+    let out = momaro(&["generate", "--count", "0", "--out", d]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("count"));
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing written");
+}

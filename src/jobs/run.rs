@@ -23,6 +23,7 @@ use crate::geometry::{Pose2, wrap_angle};
 use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor};
 use crate::motion::{DetailedPath, MotionError, MotionOptions, Phase, expand_path};
 use crate::progress::SimProgress;
+use crate::rng::Rng;
 use crate::robot::Leg;
 use crate::robot::ik::IkError;
 use crate::scenario::{Outcome, Scenario, Stepping};
@@ -80,7 +81,7 @@ pub struct PoseNoise {
     pub position_std_m: f64,
     /// Standard deviation of yaw, rad.
     pub yaw_std_rad: f64,
-    /// Seed of the generator.
+    /// Seed of the generator (the raw xorshift64* state, `rng::Rng::from_state`).
     pub seed: u64,
 }
 
@@ -276,31 +277,6 @@ pub struct RunSummary {
     pub expectations: Vec<ExpectationResult>,
     /// Monitor events.
     pub events: Vec<MonitorEvent>,
-}
-
-/// A small deterministic generator (xorshift64*) with Box–Muller normals, so noisy runs are
-/// reproducible without another dependency.
-struct Noise {
-    state: u64,
-}
-
-impl Noise {
-    fn new(seed: u64) -> Self {
-        Self { state: seed.max(1) }
-    }
-
-    fn uniform(&mut self) -> f64 {
-        self.state ^= self.state >> 12;
-        self.state ^= self.state << 25;
-        self.state ^= self.state >> 27;
-        let v = self.state.wrapping_mul(0x2545_F491_4F6C_DD1D);
-        ((v >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    fn normal(&mut self) -> f64 {
-        let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
 }
 
 fn expectations(scenario: &Scenario, s: &RunSummary) -> Vec<ExpectationResult> {
@@ -588,7 +564,7 @@ pub fn execute(
     let control_dt = substeps as f64 * dt;
     let mut monitor =
         StabilityMonitor::new(MonitorLimits { settle_s: SETTLE_S, ..MonitorLimits::default() });
-    let mut noise = opts.noise.map(|n| (n, Noise::new(n.seed)));
+    let mut noise = opts.noise.map(|n| (n, Rng::from_state(n.seed)));
     let timeout = scenario.expect.timeout_s;
     let progress = SimProgress::new(&scenario.name, timeout, opts.progress);
     let (mut max_track, mut sum_track, mut n_track, mut max_pitch) = (0.0f64, 0.0, 0usize, 0.0f64);

@@ -6,6 +6,7 @@
 //! wrong plan. The terrain primitives feed both the MuJoCo world (`sim::world`) and the
 //! rasterised height map (`terrain`).
 
+pub mod generate;
 pub mod terrain;
 
 use crate::geometry::Pose2;
