@@ -112,9 +112,13 @@ pub struct MonitorLimits {
     /// Roll or pitch beyond this is a tip-over, rad: steps pitch the base by at most about
     /// 15°, so 35° is a robot falling, not climbing.
     pub max_tilt_rad: f64,
-    /// A base sinking faster than this is falling, m/s: the slowest joint motion the
-    /// controllers command lowers it at about 0.1 m/s.
+    /// A base sinking faster than this for [`Self::fall_duration_s`] is falling, m/s:
+    /// the controllers lower it at about 0.1 m/s.
     pub fall_speed_m_s: f64,
+    /// How long the base must sink that fast to count as a fall, s: a wheel rolling off
+    /// a 5 cm bump drops the base at that speed for under 0.1 s; a robot tipping over or
+    /// off a step keeps falling.
+    pub fall_duration_s: f64,
     /// A wheel this close to the terrain supports the robot, m: the wheels' contact gap
     /// in the model, within the foam's compression under load.
     pub support_gap_m: f64,
@@ -124,6 +128,9 @@ pub struct MonitorLimits {
     pub expected_wheels: usize,
     /// Samples before this time only update the wheel memory (the robot settles), s.
     pub settle_s: f64,
+    /// A margin counts toward the run's minimum when held this long, s: longer than a
+    /// wheel's bounce off a bump edge (the support memory), short against any lean.
+    pub margin_hold_s: f64,
 }
 
 impl Default for MonitorLimits {
@@ -131,10 +138,12 @@ impl Default for MonitorLimits {
         Self {
             max_tilt_rad: 35f64.to_radians(),
             fall_speed_m_s: 0.5,
+            fall_duration_s: 0.15,
             support_gap_m: 0.004,
             support_memory_s: 0.03,
             expected_wheels: 8,
             settle_s: 0.0,
+            margin_hold_s: 0.05,
         }
     }
 }
@@ -154,8 +163,13 @@ struct OpenViolation {
 #[derive(Debug, Clone)]
 pub struct StabilityMonitor {
     limits: MonitorLimits,
-    /// Smallest margin seen, m.
+    /// Smallest margin the robot held for at least [`MonitorLimits::margin_hold_s`], m:
+    /// the smallest over time of the largest margin within the last `margin_hold_s` (a
+    /// dip shorter than that, a wheel bouncing off a bump edge, does not count fully;
+    /// the dips below zero are the static violations, timed).
     pub min_margin: f64,
+    /// Smallest margin of any single sample, m.
+    pub min_instant_margin: f64,
     /// Fewest supporting wheels seen.
     pub min_wheels: usize,
     /// Largest |roll| or |pitch| seen, rad.
@@ -169,6 +183,10 @@ pub struct StabilityMonitor {
     /// Per wheel (leg-major): last time it touched and where.
     last_touch: [Option<(f64, [f64; 2])>; 8],
     last_time: Option<f64>,
+    /// When the base began sinking faster than the fall speed (None: it is not).
+    sinking_since: Option<f64>,
+    /// Recent (time, margin) samples, margins decreasing: the sliding window maximum.
+    window: std::collections::VecDeque<(f64, f64)>,
     violation: Option<OpenViolation>,
     tipped: bool,
     contact_lost: bool,
@@ -181,6 +199,8 @@ impl StabilityMonitor {
         Self {
             limits,
             min_margin: f64::INFINITY,
+            min_instant_margin: f64::INFINITY,
+            window: std::collections::VecDeque::new(),
             min_wheels: usize::MAX,
             max_tilt: 0.0,
             static_violation_s: 0.0,
@@ -188,6 +208,7 @@ impl StabilityMonitor {
             events: Vec::new(),
             last_touch: [None; 8],
             last_time: None,
+            sinking_since: None,
             violation: None,
             tipped: false,
             contact_lost: false,
@@ -263,7 +284,21 @@ impl StabilityMonitor {
     pub fn record(&mut self, s: &StabilitySample) {
         let dt = self.last_time.map_or(0.0, |t| (s.time - t).max(0.0));
         self.last_time = Some(s.time);
-        self.min_margin = self.min_margin.min(s.margin);
+        self.min_instant_margin = self.min_instant_margin.min(s.margin);
+        while self.window.back().is_some_and(|&(_, m)| m <= s.margin) {
+            self.window.pop_back();
+        }
+        self.window.push_back((s.time, s.margin));
+        while self
+            .window
+            .front()
+            .is_some_and(|&(t, _)| t < s.time - self.limits.margin_hold_s - 1e-9)
+        {
+            self.window.pop_front();
+        }
+        if let Some(&(_, held)) = self.window.front() {
+            self.min_margin = self.min_margin.min(held);
+        }
         self.min_wheels = self.min_wheels.min(s.contacts.len());
         let tilt = s.tilt();
         self.max_tilt = self.max_tilt.max(tilt);
@@ -282,11 +317,18 @@ impl StabilityMonitor {
         }
 
         // Tip-over.
+        self.sinking_since = if s.vertical_speed < -self.limits.fall_speed_m_s {
+            Some(self.sinking_since.unwrap_or(s.time))
+        } else {
+            None
+        };
+        let falling =
+            self.sinking_since.is_some_and(|t0| s.time - t0 >= self.limits.fall_duration_s - 1e-9);
         let cause = if tilt > self.limits.max_tilt_rad {
             Some(TipCause::Tilt)
         } else if s.body_collisions.iter().any(|b| b == TRUNK_BODY) {
             Some(TipCause::TrunkContact)
-        } else if s.vertical_speed < -self.limits.fall_speed_m_s {
+        } else if falling {
             Some(TipCause::Fall)
         } else {
             None
@@ -459,11 +501,42 @@ mod tests {
     }
 
     #[test]
+    fn the_run_minimum_is_the_margin_held_for_the_hold_time() {
+        let mut m = StabilityMonitor::new(MonitorLimits::default());
+        let left: Vec<WheelReading> =
+            wheels(0.0).into_iter().filter(|w| [0, 1, 4, 5].contains(&w.index)).collect();
+        // 0.36 m for a while; then the CoM 0.14 m to the left (0.22 m inside all eight
+        // wheels) while the right wheels are off for 60 ms: the margin drops to −0.10
+        // once the 30 ms memory has passed, for 30 ms, then they are back. The held
+        // minimum is 0.22; the instant one −0.10.
+        for k in 0..10 {
+            level(&mut m, 0.01 * f64::from(k), [0.0, 0.0], &wheels(0.0));
+        }
+        for k in 10..16 {
+            level(&mut m, 0.01 * f64::from(k), [0.0, 0.14], &left);
+        }
+        for k in 16..30 {
+            level(&mut m, 0.01 * f64::from(k), [0.0, 0.0], &wheels(0.0));
+        }
+        assert!((m.min_instant_margin + 0.10).abs() < 1e-9, "{}", m.min_instant_margin);
+        assert!((m.min_margin - 0.22).abs() < 1e-9, "{}", m.min_margin);
+        // Held for longer than 50 ms: it counts.
+        for k in 30..40 {
+            level(&mut m, 0.01 * f64::from(k), [0.0, 0.14], &left);
+        }
+        assert!((m.min_margin + 0.10).abs() < 1e-9, "{}", m.min_margin);
+    }
+
+    #[test]
     fn tilt_trunk_contact_and_a_fall_are_tip_overs() {
+        // Each condition held for 0.2 s.
         let tip = |roll: f64, vz: f64, bodies: Vec<String>| {
             let mut m = StabilityMonitor::new(MonitorLimits::default());
-            let s = m.sample(0.0, [0.0, 0.0, 0.5], &wheels(0.0), [roll, 0.0], vz, bodies);
-            m.record(&s);
+            for k in 0..=20 {
+                let t = 0.01 * f64::from(k);
+                let s = m.sample(t, [0.0, 0.0, 0.5], &wheels(0.0), [roll, 0.0], vz, bodies.clone());
+                m.record(&s);
+            }
             m.events.iter().find_map(|e| match e {
                 MonitorEvent::TipOver { cause, .. } => Some(*cause),
                 _ => None,
@@ -475,5 +548,14 @@ mod tests {
         assert_eq!(tip(0.0, -1.0, vec![]), Some(TipCause::Fall));
         // A shin on a stair nosing is a collision event, not a fall.
         assert_eq!(tip(0.0, 0.0, vec!["fl_shin".into()]), None);
+        // A wheel rolling off a bump: 0.08 s of fast sinking is no fall.
+        let mut m = StabilityMonitor::new(MonitorLimits::default());
+        for k in 0..=30 {
+            let t = 0.01 * f64::from(k);
+            let vz = if (0.1..0.18).contains(&t) { -0.6 } else { 0.0 };
+            let s = m.sample(t, [0.0, 0.0, 0.5], &wheels(0.0), [0.0, 0.0], vz, Vec::new());
+            m.record(&s);
+        }
+        assert!(!m.tipped(), "{:?}", m.events);
     }
 }

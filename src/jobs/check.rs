@@ -761,6 +761,7 @@ mod tests {
             failure_kind,
             push: None,
             min_stability_margin_m: 0.1,
+            min_instant_margin_m: 0.1,
             static_violation_s,
             worst_static_violation_m: 0.0,
             tipped,

@@ -253,9 +253,11 @@ pub struct RunSummary {
     pub failure_kind: Option<FailureKind>,
     /// The push and the margins around it, if one was applied.
     pub push: Option<PushReport>,
-    /// Smallest measured stability margin after settling, m (over the supporting wheels,
-    /// see `monitor`).
+    /// Smallest stability margin held for 50 ms after settling, m (over the supporting
+    /// wheels, see `monitor`).
     pub min_stability_margin_m: f64,
+    /// Smallest margin of any single sample, m.
+    pub min_instant_margin_m: f64,
     /// Total time the CoM lay outside the support polygon, s.
     pub static_violation_s: f64,
     /// Most negative margin of those violations, m (0 if none).
@@ -460,6 +462,7 @@ fn unexecuted(
         failure_kind: Some(kind),
         push: None,
         min_stability_margin_m: f64::INFINITY,
+        min_instant_margin_m: f64::INFINITY,
         static_violation_s: 0.0,
         worst_static_violation_m: 0.0,
         tipped: false,
@@ -764,6 +767,7 @@ pub fn execute(
         failure_kind,
         push: push_report,
         min_stability_margin_m: monitor.min_margin,
+        min_instant_margin_m: monitor.min_instant_margin,
         static_violation_s: monitor.static_violation_s,
         worst_static_violation_m: monitor.worst_violation_m,
         tipped: monitor.tipped(),

@@ -345,6 +345,42 @@ impl HeightMap {
         best
     }
 
+    /// Where a sphere of radius `r` (a wheel) lowered onto the terrain at (x, y) comes to
+    /// rest: the height of its lowest point, m. Each cell (flat-topped at its height, a
+    /// square) holds the sphere up by `h + √(r² − d²) − r`, d the horizontal distance from
+    /// the sphere's centre to the cell's nearest point; the highest of these. A wheel
+    /// rolling over a box edge rises along the arc this traces, not in a step. Cells above
+    /// `max_top` are walls the wheel presses against, not tops it can roll onto: they are
+    /// left out. `None` if no cell under the sphere is known.
+    pub fn wheel_rest_height(&self, x: f64, y: f64, r: f64, max_top: f64) -> Option<f64> {
+        let res = self.resolution;
+        let span = |v: f64, o: f64, n: usize| {
+            let lo = (((v - r - o) / res).floor().max(0.0)) as usize;
+            let hi = (((v + r - o) / res).floor() as i64).min(n as i64 - 1);
+            (lo, hi)
+        };
+        let (i0, i1) = span(x, self.origin[0], self.nx);
+        let (j0, j1) = span(y, self.origin[1], self.ny);
+        let mut best: Option<f64> = None;
+        for j in j0..=usize::try_from(j1).ok()? {
+            let y0 = self.origin[1] + j as f64 * res;
+            let dy = (y0 - y).max(0.0).max(y - (y0 + res));
+            for i in i0..=usize::try_from(i1).ok()? {
+                let x0 = self.origin[0] + i as f64 * res;
+                let dx = (x0 - x).max(0.0).max(x - (x0 + res));
+                let d2 = dx * dx + dy * dy;
+                if d2 > r * r {
+                    continue;
+                }
+                if let Some(h) = self.get(i, j).filter(|&h| h <= max_top) {
+                    let z = h + (r * r - d2).sqrt() - r;
+                    best = Some(best.map_or(z, |b: f64| b.max(z)));
+                }
+            }
+        }
+        best
+    }
+
     /// Highest known terrain over the cells whose centres lie within `radius` of the
     /// segment from `a` to `b` (x, y; the ends' z count too), m: what a foot carried along
     /// the segment must clear.
@@ -509,6 +545,26 @@ mod tests {
         assert_eq!(hm.max_around(0.05, 0.05, 1), Some(11.0));
         assert_eq!(hm.max_around(0.35, 0.35, 0), Some(33.0));
         assert_eq!(hm.max_around(-1.0, 0.0, 1), None);
+    }
+
+    #[test]
+    fn a_wheel_rests_on_a_box_edge_along_its_arc() {
+        // Floor at 0, a 0.04 m box from x = 1.0 on; wheel radius 0.08.
+        let hm = HeightMap::from_fn([0.0, 0.0], 0.025, 80, 20, |i, _| {
+            if (i as f64) * 0.025 >= 1.0 { 0.04 } else { 0.0 }
+        })
+        .unwrap();
+        let r = 0.08;
+        // Far from the edge: on the floor; on top: at the box height.
+        assert!((hm.wheel_rest_height(0.5, 0.25, r, 1.0).unwrap()).abs() < 1e-12);
+        assert!((hm.wheel_rest_height(1.5, 0.25, r, 1.0).unwrap() - 0.04).abs() < 1e-12);
+        // Centre 0.05 m before the edge: the edge holds it at 0.04 + √(0.08² − 0.05²) − 0.08.
+        let z = hm.wheel_rest_height(0.95, 0.25, r, 1.0).unwrap();
+        assert!((z - (0.04 + (0.0064f64 - 0.0025).sqrt() - 0.08)).abs() < 1e-12, "{z}");
+        // A wall (above `max_top`) is pressed against, not climbed.
+        assert!(hm.wheel_rest_height(0.95, 0.25, r, 0.03).unwrap().abs() < 1e-12);
+        // Beyond the radius the edge does not touch it.
+        assert!(hm.wheel_rest_height(0.91, 0.25, r, 1.0).unwrap().abs() < 1e-12);
     }
 
     #[test]

@@ -63,7 +63,7 @@ impl StepExecutor {
                 Some(q)
             }
             Err(e) => {
-                self.fail(ExecFailure::Ik(e.to_string()), time);
+                self.fail(ExecFailure::Ik { message: e.to_string() }, time);
                 None
             }
         }

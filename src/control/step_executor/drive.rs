@@ -6,9 +6,47 @@
 use super::{Command, ExecFailure, Mode, Observation, StepExecutor};
 use crate::control::path_follower::{FollowerStatus, PathFollower};
 use crate::geometry::wrap_angle;
-use crate::motion::kinematics::{contacts_in_base, interpolate};
+use crate::motion::kinematics::{Posture, contacts_in_base, interpolate};
+
+/// How far a drive run moves a foot from its keyframe height to where its wheels rest,
+/// m: the foot cost's largest height difference within r_F (eq. 2), the most a wheel
+/// meets while driving.
+const WHEEL_REST_RANGE_M: f64 = 0.05;
 
 impl StepExecutor {
+    /// `p` with each foot at the height where its wheel pair rests on the height map
+    /// (the higher of its two wheels, [`crate::terrain::HeightMap::wheel_rest_height`], with the pair
+    /// turned by its measured steering), within [`WHEEL_REST_RANGE_M`] of the keyframes'
+    /// height: legs lengthen and shorten with the ground under the wheels, so every
+    /// wheel keeps the ground over bumps the foot cost lets the robot drive on, rather
+    /// than the stiff legs lifting a diagonal off it. The base rises with the highest
+    /// foot's rise (as `motion::kinematics::driving_posture` sets it by the highest
+    /// foot): the driving height folds the knees nearly to their limit, so no leg may get
+    /// shorter than planned.
+    fn on_wheel_rest_heights(&self, mut p: Posture, obs: &Observation) -> Posture {
+        let mut rise = 0.0_f64;
+        let r = self.robot.wheel_radius;
+        let half_track = self.robot.wheel_track / 2.0;
+        for (i, f) in p.feet.iter_mut().enumerate() {
+            let (s, c) = (p.base_rpy[2] + obs.steering[i]).sin_cos();
+            let top = f[2] + WHEEL_REST_RANGE_M;
+            let rest = [-1.0, 1.0]
+                .iter()
+                .filter_map(|side| {
+                    let (x, y) = (f[0] - side * half_track * s, f[1] + side * half_track * c);
+                    self.ground.wheel_rest_height(x, y, r, top)
+                })
+                .fold(None, |a: Option<f64>, z| Some(a.map_or(z, |a| a.max(z))));
+            if let Some(z) = rest {
+                let z = z.clamp(f[2] - WHEEL_REST_RANGE_M, top);
+                rise = rise.max(z - f[2]);
+                f[2] = z;
+            }
+        }
+        p.base_position[2] += rise;
+        p
+    }
+
     #[allow(clippy::too_many_arguments)]
     pub(super) fn drive_tick(
         &mut self,
@@ -58,6 +96,7 @@ impl StepExecutor {
         } else {
             self.keys[a_idx].posture()
         };
+        let p = self.on_wheel_rest_heights(p, obs);
         self.cmd = p;
         self.wheel_hold = [None; 4];
         self.mode = Mode::Drive { follower, first, last };

@@ -190,11 +190,17 @@ pub enum ExecFailure {
         heading_rad: f64,
     },
     /// A posture could not be solved.
-    #[error("leg IK: {0}")]
-    Ik(String),
+    #[error("leg IK: {message}")]
+    Ik {
+        /// The solver's message.
+        message: String,
+    },
     /// The path follower rejected a drive run.
-    #[error("path follower: {0}")]
-    Follower(String),
+    #[error("path follower: {message}")]
+    Follower {
+        /// The follower's message.
+        message: String,
+    },
 }
 
 /// What the executor is doing after a tick.
@@ -257,4 +263,23 @@ pub struct ExecEvent {
     pub time_s: f64,
     /// What happened.
     pub event: ExecEventKind,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_failure_serialises_in_an_event() {
+        // serde cannot write a tagged newtype variant holding a string: `run --json` once
+        // failed on an IK failure with "cannot serialize tagged newtype variant".
+        for failure in [
+            ExecFailure::Ik { message: "knee".into() },
+            ExecFailure::Follower { message: "path".into() },
+        ] {
+            let e = ExecEvent { time_s: 1.0, event: ExecEventKind::Failure { failure } };
+            let v = serde_json::to_value(&e).expect("serialises");
+            assert!(v["event"]["failure"]["message"].is_string(), "{v}");
+        }
+    }
 }

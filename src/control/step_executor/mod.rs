@@ -258,7 +258,7 @@ impl StepExecutor {
                         self.fading = None;
                         self.mode = Mode::Drive { follower: Box::new(f), first: i, last };
                     }
-                    Err(e) => self.fail(ExecFailure::Follower(e.to_string()), time),
+                    Err(e) => self.fail(ExecFailure::Follower { message: e.to_string() }, time),
                 }
             }
             Phase::Lift => {
