@@ -135,6 +135,12 @@ pub enum Command {
         /// matrix or a cluster job array, K = 1..N, run every file exactly once.
         #[arg(long, value_name = "K/N")]
         shard: Option<String>,
+        /// What fails the command: `all` (any scenario that does not pass) or `safety`
+        /// (only a fall, a plan the motion generator rejects, a static violation past its
+        /// bound, an impossible course not refused, or an error; goals not reached are
+        /// reported, not failed: for suites of generated courses).
+        #[arg(long, value_enum, default_value_t = FailOn::All)]
+        fail_on: FailOn,
         /// Print the results as JSON.
         #[arg(long)]
         json: bool,
@@ -170,6 +176,15 @@ pub enum Command {
         #[command(flatten)]
         model: ModelArgs,
     },
+}
+
+/// What fails `momaro check`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FailOn {
+    /// Any scenario that does not pass.
+    All,
+    /// Only safety failures (see `check --help`).
+    Safety,
 }
 
 /// Search algorithm.
@@ -360,6 +375,7 @@ fn check(
     planner: &PlannerArgs,
     jobs: Option<usize>,
     shard: Option<&str>,
+    fail_on: FailOn,
     json: bool,
     model: PathBuf,
 ) -> anyhow::Result<bool> {
@@ -404,7 +420,10 @@ fn check(
             report.total.invalid, report.total.cases
         ))));
     }
-    Ok(report.all_passed())
+    Ok(match fail_on {
+        FailOn::All => report.all_passed(),
+        FailOn::Safety => report.safe(),
+    })
 }
 
 fn print_check_table(report: &jobs::check::CheckReport) {
@@ -459,7 +478,7 @@ fn print_check_table(report: &jobs::check::CheckReport) {
     }
     say!("");
     say!(
-        "{:<class_w$}  {:>5}  {:>6}  {:>6}  {:>6}  {:>7}  {:>7}  {:>7}  {:>10}  {:>6}  {:>12}",
+        "{:<class_w$}  {:>5}  {:>6}  {:>6}  {:>6}  {:>7}  {:>7}  {:>7}  {:>10}  {:>6}  {:>12}  {:>18}",
         "class",
         "cases",
         "passed",
@@ -470,11 +489,12 @@ fn print_check_table(report: &jobs::check::CheckReport) {
         "no path",
         "motion gen",
         "tipped",
-        "static > max"
+        "static > max",
+        "impossible planned"
     );
     let line = |name: &str, t: &jobs::check::Totals| {
         say!(
-            "{:<class_w$}  {:>5}  {:>6}  {:>6}  {:>6}  {:>7}  {:>7}  {:>7}  {:>10}  {:>6}  {:>12}",
+            "{:<class_w$}  {:>5}  {:>6}  {:>6}  {:>6}  {:>7}  {:>7}  {:>7}  {:>10}  {:>6}  {:>12}  {:>18}",
             name,
             t.cases,
             t.passed,
@@ -485,7 +505,8 @@ fn print_check_table(report: &jobs::check::CheckReport) {
             t.no_path,
             t.motion_generation,
             t.tipped,
-            t.static_violation_exceeded
+            t.static_violation_exceeded,
+            t.impossible_not_refused
         );
     };
     for (class, t) in &report.classes {
@@ -752,8 +773,8 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             }
             Ok(s.passed)
         }
-        Command::Check { paths, planner, jobs, shard, json, model } => {
-            check(&paths, &planner, jobs, shard.as_deref(), json, model.model)
+        Command::Check { paths, planner, jobs, shard, fail_on, json, model } => {
+            check(&paths, &planner, jobs, shard.as_deref(), fail_on, json, model.model)
         }
         Command::Bench(BenchCommand::Plan {
             scenario,

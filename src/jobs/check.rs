@@ -374,6 +374,20 @@ pub struct Totals {
     pub tipped: usize,
     /// Runs whose static-stability violations lasted longer than the scenario allows.
     pub static_violation_exceeded: usize,
+    /// Impossible courses (`expect.outcome = "no_path"`) that were not answered "no path".
+    pub impossible_not_refused: usize,
+}
+
+impl Totals {
+    /// Runs that broke what must hold on any terrain: a fall, a plan the motion
+    /// generator rejected, a static violation past the bound, or an impossible course
+    /// not refused. (Not reaching a reachable goal is a failure, but not a safety one.)
+    pub fn unsafe_runs(&self) -> usize {
+        self.tipped
+            + self.motion_generation
+            + self.static_violation_exceeded
+            + self.impossible_not_refused
+    }
 }
 
 impl Totals {
@@ -394,6 +408,8 @@ impl Totals {
             self.tipped += usize::from(s.tipped);
             self.static_violation_exceeded +=
                 usize::from(s.static_violation_s > *max_static_violation_s);
+            self.impossible_not_refused +=
+                usize::from(s.expectations.iter().any(|e| e.name == "outcome" && !e.passed));
         }
     }
 }
@@ -430,6 +446,12 @@ impl CheckReport {
     /// Whether every scenario passed.
     pub fn all_passed(&self) -> bool {
         self.total.passed == self.total.cases
+    }
+
+    /// Whether no run broke a safety property ([`Totals::unsafe_runs`]) and none
+    /// ended in an error.
+    pub fn safe(&self) -> bool {
+        self.total.unsafe_runs() == 0 && self.total.errors == 0
     }
 
     /// Whether some scenario was invalid input.
@@ -821,6 +843,7 @@ mod tests {
                 motion_generation: 1,
                 tipped: 1,
                 static_violation_exceeded: 1,
+                impossible_not_refused: 0,
             }
         );
         assert_eq!(
@@ -836,6 +859,7 @@ mod tests {
                 motion_generation: 0,
                 tipped: 0,
                 static_violation_exceeded: 0,
+                impossible_not_refused: 0,
             }
         );
         assert_eq!(
@@ -855,8 +879,36 @@ mod tests {
                 motion_generation: 1,
                 tipped: 1,
                 static_violation_exceeded: 1,
+                impossible_not_refused: 0,
             }
         );
+        // Safety: the fall (also over its static bound) and the motion failure.
+        assert_eq!(total.unsafe_runs(), 3);
+    }
+
+    #[test]
+    fn an_impossible_course_that_gets_a_plan_is_unsafe_and_an_unreached_goal_is_not() {
+        let mut planned = summary(false, true, None, false, 0.0);
+        planned.expectations.push(crate::jobs::run::ExpectationResult {
+            name: "outcome",
+            passed: false,
+            detail: "a plan".into(),
+        });
+        let unreached = summary(false, false, Some(FailureKind::PlanningTimeLimit), false, 0.0);
+        let rows = vec![ran(Some("impossible"), planned, 0.1), ran(Some("stairs"), unreached, 0.1)];
+        let (classes, total) = aggregate(&rows);
+        assert_eq!(classes["impossible"].impossible_not_refused, 1);
+        assert_eq!(classes["stairs"].unsafe_runs(), 0);
+        assert_eq!(total.unsafe_runs(), 1);
+        let report = CheckReport {
+            jobs: 1,
+            shard: None,
+            wall_time_s: 0.0,
+            rows: rows.clone(),
+            classes,
+            total,
+        };
+        assert!(!report.safe() && !report.all_passed());
     }
 
     #[test]

@@ -204,9 +204,10 @@ impl StepBound {
         let min_cf = comps.iter().map(|c| c.min_cf).fold(f64::INFINITY, f64::min);
         let (offset_per_m, lambda) = offset_potential(params, min_cf);
         let k7 = params.k7 * (1.0 - lambda);
+        let crossings = Crossings::build(hm, &comp, &comps, params.max_step_height_m);
         let weight = |a: usize, b: usize| -> Option<Cost> {
             let (ca, cb) = (&comps[a], &comps[b]);
-            if !ca.near {
+            if !ca.near || !crossings.may_step(a, b) {
                 return None;
             }
             let gap = (cb.min_h - ca.max_h).max(ca.min_h - cb.max_h).max(0.0);
@@ -294,6 +295,107 @@ impl StepBound {
     pub fn offset_potential(&self, o: &[i8; 4]) -> Cost {
         let cells: i32 = o.iter().map(|&v| i32::from(v).abs()).sum();
         Cost::from_f64_floor(self.offset_per_cell * f64::from(cells) * (1.0 - 1e-9))
+    }
+}
+
+/// Which component pairs a step could join at all (criterion 3 over the whole swing).
+///
+/// A step of a foot standing at height `h0` samples the cells along its line every cell
+/// width and stops at the first whose height differs from `h0` by more than the largest
+/// step height, or that is unknown (`HybridGraph::best_step`). So every cell it passes,
+/// the landing cell included, is known and at most `max_h(A) + max_step` high, and
+/// consecutive ones touch (8-neighbours). Per threshold `t = max_h(A) + max_step` the
+/// known cells at most `t` high split into 8-connected *passes*; a step from A can land
+/// only in a component B that has a cell in a pass holding a cell of A. A wall more than
+/// a step height above both sides is thus no step edge, however thin: a room walled in
+/// by it has an infinite step bound, and the search ends at once with no path.
+struct Crossings {
+    /// Per component: index of its threshold in `passes`, or `None` (no filter).
+    threshold: Vec<Option<usize>>,
+    /// Per threshold, per component: the passes its cells lie in (sorted).
+    passes: Vec<Vec<Vec<u32>>>,
+}
+
+/// Most distinct thresholds [`Crossings`] labels; beyond it the filter is off (every
+/// pair may step), which is sound.
+const MAX_THRESHOLDS: usize = 64;
+
+impl Crossings {
+    fn build(
+        hm: &crate::terrain::HeightMap,
+        comp: &[u32],
+        comps: &[Component],
+        max_step: f64,
+    ) -> Self {
+        let (nx, ny) = hm.dims();
+        let k = comps.len();
+        // Thresholds to the millimetre, rounded up (a larger threshold only merges).
+        let key = |c: &Component| ((c.max_h + max_step) * 1000.0).ceil() as i64;
+        let mut keys: Vec<i64> = comps.iter().map(key).collect();
+        keys.sort_unstable();
+        keys.dedup();
+        if keys.len() > MAX_THRESHOLDS {
+            return Self { threshold: vec![None; k], passes: Vec::new() };
+        }
+        let threshold = comps.iter().map(|c| keys.binary_search(&key(c)).ok()).collect::<Vec<_>>();
+        let heights = hm.as_slice();
+        let mut passes = Vec::with_capacity(keys.len());
+        let mut label = vec![u32::MAX; nx * ny];
+        let mut stack = Vec::new();
+        for &kk in &keys {
+            let t = kk as f64 / 1000.0;
+            label.fill(u32::MAX);
+            let mut next = 0u32;
+            for start in 0..nx * ny {
+                let h = heights[start];
+                if label[start] != u32::MAX || h.is_nan() || h > t {
+                    continue;
+                }
+                label[start] = next;
+                stack.push(start);
+                while let Some(c) = stack.pop() {
+                    let (i, j) = ((c % nx) as isize, (c / nx) as isize);
+                    for b in (j - 1).max(0)..=(j + 1).min(ny as isize - 1) {
+                        for a in (i - 1).max(0)..=(i + 1).min(nx as isize - 1) {
+                            let n = b as usize * nx + a as usize;
+                            if label[n] == u32::MAX && heights[n] <= t {
+                                label[n] = next;
+                                stack.push(n);
+                            }
+                        }
+                    }
+                }
+                next += 1;
+            }
+            let mut per_comp: Vec<Vec<u32>> = vec![Vec::new(); k];
+            for (c, &id) in comp.iter().enumerate() {
+                if id != NONE && label[c] != u32::MAX {
+                    per_comp[id as usize].push(label[c]);
+                }
+            }
+            for v in &mut per_comp {
+                v.sort_unstable();
+                v.dedup();
+            }
+            passes.push(per_comp);
+        }
+        Self { threshold, passes }
+    }
+
+    /// Whether a step from component `a` could land in component `b`.
+    fn may_step(&self, a: usize, b: usize) -> bool {
+        let Some(t) = self.threshold.get(a).copied().flatten() else { return true };
+        let (pa, pb) = (&self.passes[t][a], &self.passes[t][b]);
+        // Sorted: a merge finds a shared pass.
+        let (mut x, mut y) = (0, 0);
+        while x < pa.len() && y < pb.len() {
+            match pa[x].cmp(&pb[y]) {
+                std::cmp::Ordering::Equal => return true,
+                std::cmp::Ordering::Less => x += 1,
+                std::cmp::Ordering::Greater => y += 1,
+            }
+        }
+        false
     }
 }
 

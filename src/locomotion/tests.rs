@@ -462,6 +462,29 @@ mod hybrid {
     }
 
     #[test]
+    fn a_thin_wall_a_step_cannot_cross_makes_the_bound_infinite() {
+        // A 0.1 m thick wall across the whole map at x = 1.5. Floor on both sides, so the
+        // components' heights do not tell it apart; what does is that every cell a step
+        // passes stays within 0.3 m of the foot's ground (criterion 3).
+        let wall = |h: f64| {
+            let prims =
+                [Primitive::Box { center: [1.5, 0.0], size: [0.1, 2.4], height: h, yaw_deg: 0.0 }];
+            let m = rasterise(&prims, [-1.0, -1.0], [4.0, 2.0], 0.025).expect("map");
+            CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps")
+        };
+        let high = wall(0.5);
+        let goal_high = state_at(&graph(&high, LatticeState::new(0, 0, 0)), 2.5, 0.0);
+        let g = graph(&high, goal_high);
+        assert!(g.heuristic(state_at(&g, 0.0, 0.0)).is_infinite(), "0.5 m wall");
+        assert!(!g.heuristic(state_at(&g, 2.4, 0.0)).is_infinite(), "the goal's side");
+        // A 0.25 m bar can be stepped over: the bound stays finite.
+        let low = wall(0.25);
+        let goal_low = state_at(&graph(&low, LatticeState::new(0, 0, 0)), 2.5, 0.0);
+        let g = graph(&low, goal_low);
+        assert!(!g.heuristic(state_at(&g, 0.0, 0.0)).is_infinite(), "0.25 m bar");
+    }
+
+    #[test]
     fn step_bound_is_one_platform_step_per_foot() {
         // Floor and platform top are two foot components 0.2 m apart in height. C_F is
         // infinite within r_F = 0.12 m of the edge cells (centres 0.9875 and 1.0125), so
