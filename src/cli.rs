@@ -136,9 +136,10 @@ pub enum Command {
         #[arg(long, value_name = "K/N")]
         shard: Option<String>,
         /// What fails the command: `all` (any scenario that does not pass) or `safety`
-        /// (only a fall, a plan the motion generator rejects, a static violation past its
-        /// bound, an impossible course not refused, or an error; goals not reached are
-        /// reported, not failed: for suites of generated courses).
+        /// (only a fall, a static violation past its bound, an impossible course not
+        /// refused, or an error; goals not reached and plans the motion generator
+        /// rejects, which stop the run before the robot moves, are reported, not failed:
+        /// for suites of generated courses).
         #[arg(long, value_enum, default_value_t = FailOn::All)]
         fail_on: FailOn,
         /// Print the results as JSON.

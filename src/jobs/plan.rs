@@ -23,7 +23,7 @@ use crate::cost::{Cost as CostValue, CostError, CostMaps};
 use crate::geometry::Pose2;
 use crate::locomotion::{
     Algorithm, DrivingGoal, HybridConfig, HybridGraph, LatticeError, LatticeState, ManoeuvreKind,
-    Neighbourhood, StepCost,
+    Neighbourhood, PoseKey, StepCost,
 };
 use crate::params::{InvalidParam, Params};
 use crate::planner::{
@@ -57,6 +57,9 @@ pub struct PlanOptions {
     pub step_cost_factor: Option<f64>,
     /// Driving neighbourhood; default N16 for A*, N20 for ARA* (Sec. VII-B).
     pub neighbourhood: Option<Neighbourhood>,
+    /// Edges to leave out: manoeuvres the motion generator could not expand in an
+    /// earlier plan of the same run (`jobs::run::plan_mission`).
+    pub forbidden: Vec<(PoseKey, PoseKey)>,
 }
 
 impl Default for PlanOptions {
@@ -69,6 +72,7 @@ impl Default for PlanOptions {
             k12: None,
             step_cost_factor: None,
             neighbourhood: None,
+            forbidden: Vec::new(),
         }
     }
 }
@@ -287,6 +291,10 @@ pub struct PlanSummary {
     pub k12: f64,
     /// The grid.
     pub map: MapInfo,
+    /// The path's states by cell, orientation and foot offsets (to forbid an edge of it
+    /// in a replan).
+    #[serde(skip)]
+    pub keys: Vec<PoseKey>,
 }
 
 /// Snake-case name of a termination.
@@ -519,6 +527,7 @@ pub fn run(
     let neighbourhood = opts.neighbourhood.unwrap_or_else(|| default_neighbourhood(opts.algorithm));
     let lattice_err = |source| PlanJobError::Lattice { scenario: file(), source };
     let mut graph = prep.graph(robot, neighbourhood, prep.params.k12).map_err(lattice_err)?;
+    graph.forbid(&opts.forbidden);
     let eps0 = opts.initial_epsilon.unwrap_or(prep.params.arastar_initial_epsilon);
     let search_params = SearchParams {
         initial_epsilon: eps0,
@@ -563,6 +572,7 @@ pub fn run(
         .collect();
     let plain_costs = plain_edge_costs(&graph, &mut plain, &best.path);
     let path = describe_path(&mut graph, &best.path, &plain_costs);
+    let keys = best.path.iter().filter_map(|&s| graph.key(s)).collect();
     let steps = path.iter().filter(|e| e.kind == PathKind::Step).count();
     Ok(PlanSummary {
         scenario: scenario.name.clone(),
@@ -581,6 +591,7 @@ pub fn run(
         step_cost_factor: prep.params.step_cost_factor,
         k12: prep.params.k12,
         map: prep.map_info(),
+        keys,
     })
 }
 

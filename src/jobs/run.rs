@@ -384,10 +384,46 @@ pub fn plan_mission(
     opts: &PlanOptions,
 ) -> Result<Mission, RunJobError> {
     let robot = sim.robot().clone();
-    let plan = plan::run(scenario, &robot, opts)?;
-    let detailed = expand_mission(scenario, sim, &plan, plan.path.len())?;
-    Ok(Mission { plan, detailed })
+    let started = Instant::now();
+    let mut opts = opts.clone();
+    let mut planning_time_s = 0.0;
+    loop {
+        let mut plan = plan::run(scenario, &robot, &opts)?;
+        planning_time_s += plan.planning_time_s;
+        match expand_mission(scenario, sim, &plan, plan.path.len()) {
+            Ok(detailed) => {
+                plan.planning_time_s = planning_time_s;
+                return Ok(Mission { plan, detailed });
+            }
+            Err(RunJobError::Motion { scenario: name, source }) => {
+                // The planner and the generator share one feasibility model, but the
+                // generator checks every centimetre of a manoeuvre the planner checks
+                // at its stances: what it rejects is left out and the search runs
+                // again, so a returned mission always expands.
+                let edge = source
+                    .index()
+                    .and_then(|k| Some((*plan.keys.get(k.checked_sub(1)?)?, *plan.keys.get(k)?)));
+                let left = opts.time_limit_s - started.elapsed().as_secs_f64();
+                match edge {
+                    Some(e)
+                        if opts.forbidden.len() < MAX_REJECTED_MANOEUVRES
+                            && left > 0.0
+                            && !opts.forbidden.contains(&e) =>
+                    {
+                        opts.forbidden.push(e);
+                        opts.time_limit_s = left;
+                    }
+                    _ => return Err(RunJobError::Motion { scenario: name, source }),
+                }
+            }
+            Err(e) => return Err(e),
+        }
+    }
 }
+
+/// Manoeuvres the generator may reject in one planning before the run gives up with a
+/// motion-generation failure.
+pub const MAX_REJECTED_MANOEUVRES: usize = 8;
 
 /// Expands the first `end` elements of `plan`'s path (the whole path for its length).
 ///

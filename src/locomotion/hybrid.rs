@@ -278,6 +278,8 @@ pub struct HybridGraph<'c> {
     /// Base cells that can still reach the goal (`reachability`): an infinite heuristic
     /// elsewhere proves "no path" without searching.
     regions: BaseRegions,
+    /// Edges the motion generator rejected in an earlier plan (`jobs::run`): left out.
+    forbidden: Vec<(PoseKey, PoseKey)>,
     config: HybridConfig,
     lattice: Lattice,
     /// Neutral foot positions in the base frame (x', y'), FL, FR, RL, RR.
@@ -307,6 +309,10 @@ pub struct HybridGraph<'c> {
     /// rule's IK.
     standable: HashMap<(i16, i16, u8, FootOffsets), bool, FxBuild>,
 }
+
+/// A lattice state by what it means, not by this graph's footprint ids: cell,
+/// orientation and foot offsets. Names a state across graphs (replans).
+pub type PoseKey = (i16, i16, u8, FootOffsets);
 
 /// Driving pose costs of the cost client where the shared feasibility model admits the
 /// driving posture (`feasibility::DrivingCheck::lattice_pose`), none elsewhere: the
@@ -406,6 +412,7 @@ impl<'c> HybridGraph<'c> {
             ),
             feasibility,
             regions,
+            forbidden: Vec::new(),
             near,
             config,
             lattice,
@@ -472,6 +479,17 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// The base pose of a state.
+    /// What state `s` means, independent of this graph's footprint ids.
+    pub fn key(&self, s: LatticeState) -> Option<PoseKey> {
+        self.footprints.get(s.footprint).map(|o| (s.i, s.j, s.theta, o))
+    }
+
+    /// Leaves out the edges between these states from now on (the motion generator could
+    /// not expand them: see `jobs::run::plan_mission`).
+    pub fn forbid(&mut self, edges: &[(PoseKey, PoseKey)]) {
+        self.forbidden.extend_from_slice(edges);
+    }
+
     pub fn pose(&self, s: LatticeState) -> Pose2 {
         self.lattice.pose(s)
     }
@@ -1143,11 +1161,25 @@ impl SearchGraph for HybridGraph<'_> {
     type State = LatticeState;
 
     fn successors(&mut self, s: LatticeState, out: &mut Vec<(LatticeState, Cost)>) {
+        let first = out.len();
         if s.footprint == NEUTRAL_FOOTPRINT {
             self.driving.successors(s, out);
         }
         self.special_successors(s);
         out.extend(self.special.iter().map(|&(t, c, _)| (t, c)));
+        if !self.forbidden.is_empty()
+            && let Some(from) = self.key(s)
+        {
+            let mut k = first;
+            while k < out.len() {
+                let to = self.key(out[k].0);
+                if to.is_some_and(|to| self.forbidden.contains(&(from, to))) {
+                    out.remove(k);
+                } else {
+                    k += 1;
+                }
+            }
+        }
     }
 
     /// The driving heuristic (Euclidean distance plus turn, [`DrivingGraph`]) plus the

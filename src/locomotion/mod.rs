@@ -34,8 +34,8 @@ pub use driving::{
 };
 pub use footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 pub use hybrid::{
-    HybridConfig, HybridGraph, Manoeuvre, ManoeuvreKind, ManoeuvreStats, StepCost, base_shift_cost,
-    foot_move_cost, step_cost,
+    HybridConfig, HybridGraph, Manoeuvre, ManoeuvreKind, ManoeuvreStats, PoseKey, StepCost,
+    base_shift_cost, foot_move_cost, step_cost,
 };
 pub use lattice::{Lattice, LatticeError, LatticeState, Move, NEUTRAL_FOOTPRINT, Neighbourhood};
 pub use orientation::OrientationFactor;

@@ -165,6 +165,18 @@ pub enum MotionError {
     EmptyPath,
 }
 
+impl MotionError {
+    /// The index of the path element that could not be expanded.
+    pub fn index(&self) -> Option<usize> {
+        match self {
+            Self::Step { index, .. }
+            | Self::Manoeuvre { index, .. }
+            | Self::UnknownTerrain { index, .. } => Some(*index),
+            Self::EmptyPath => None,
+        }
+    }
+}
+
 fn kind_name(k: PathKind) -> &'static str {
     match k {
         PathKind::Start => "start",
