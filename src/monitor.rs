@@ -14,11 +14,11 @@
 //!   than wheels touching terrain (a shin brushing a stair nosing is a collision, not a
 //!   fall).
 //!
-//! **Supporting wheels.** A wheel supports the robot when MuJoCo places it within
-//! [`MonitorLimits::support_gap_m`] of the terrain (the foam wheel compresses by more than
-//! that under load, so a wheel this close carries weight as soon as the robot leans onto
-//! it), or when it touched the terrain (within 1 mm) during the last
-//! [`MonitorLimits::support_memory_s`] (a wheel bouncing off a bump edge for a few
+//! **Supporting wheels.** A wheel supports the robot when MuJoCo lists a contact of it
+//! with the terrain within [`MonitorLimits::support_gap_m`] (with the model's contact
+//! margin of 0 MuJoCo lists contacts only once a wheel touches; a model with a margin
+//! would list them that far out), or when it touched the terrain (within 1 mm) during the
+//! last [`MonitorLimits::support_memory_s`] (a wheel bouncing off a bump edge for a few
 //! milliseconds still holds the robot up: static stability is about where the robot can
 //! rest, and it rests on that wheel again before it can rotate measurably). Its support
 //! point is where it last touched.
@@ -119,8 +119,9 @@ pub struct MonitorLimits {
     /// a 5 cm bump drops the base at that speed for under 0.1 s; a robot tipping over or
     /// off a step keeps falling.
     pub fall_duration_s: f64,
-    /// A wheel this close to the terrain supports the robot, m: the wheels' contact gap
-    /// in the model, within the foam's compression under load.
+    /// A wheel whose contact MuJoCo lists this close to the terrain supports the robot,
+    /// m (the foam compresses by more than that under load; with the model's margin of
+    /// 0, MuJoCo lists a wheel's contacts only once it touches).
     pub support_gap_m: f64,
     /// A wheel that touched the terrain this recently still supports the robot, s.
     pub support_memory_s: f64,

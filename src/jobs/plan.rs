@@ -381,8 +381,16 @@ pub fn prepare(
                 bounds: maps.heights().bounds(),
             });
         };
+        let fits = || {
+            crate::feasibility::DrivingCheck::new(robot, &params)
+                .lattice_pose(&maps, &lattice.pose(s))
+                .is_ok()
+        };
         let reason = match maps.driving_pose_cost(&lattice.pose(s)) {
-            CostValue::Finite(_) => None,
+            CostValue::Finite(_) if fits() => None,
+            CostValue::Finite(_) => Some(
+                "the legs or the body do not fit there, driving or standing (the feasibility model the planner and the motion generator share)",
+            ),
             CostValue::Infinite => Some(
                 "a wheel stands on or next to an untraversable height difference (infinite foot cost)",
             ),

@@ -384,39 +384,44 @@ pub fn plan_mission(
     opts: &PlanOptions,
 ) -> Result<Mission, RunJobError> {
     let robot = sim.robot().clone();
-    let started = Instant::now();
-    let mut opts = opts.clone();
-    let mut planning_time_s = 0.0;
+    let mut plan = plan::run(scenario, &robot, opts)?;
+    let mut planning_time_s = plan.planning_time_s;
+    // The planner and the generator share one feasibility model, but the generator
+    // checks every centimetre of a manoeuvre the planner checks at its stances: what it
+    // rejects is left out and the search runs again (ARA*'s first solution, each with
+    // the full time limit, so the outcome does not depend on the machine's speed). If
+    // no retry expands, the first rejection is the run's failure.
+    let mut retry = PlanOptions {
+        final_epsilon: opts.initial_epsilon.or(Some(scenario.params.arastar_initial_epsilon)),
+        ..opts.clone()
+    };
+    let mut first: Option<RunJobError> = None;
     loop {
-        let mut plan = plan::run(scenario, &robot, &opts)?;
-        planning_time_s += plan.planning_time_s;
-        match expand_mission(scenario, sim, &plan, plan.path.len()) {
+        let (name, source) = match expand_mission(scenario, sim, &plan, plan.path.len()) {
             Ok(detailed) => {
                 plan.planning_time_s = planning_time_s;
                 return Ok(Mission { plan, detailed });
             }
-            Err(RunJobError::Motion { scenario: name, source }) => {
-                // The planner and the generator share one feasibility model, but the
-                // generator checks every centimetre of a manoeuvre the planner checks
-                // at its stances: what it rejects is left out and the search runs
-                // again, so a returned mission always expands.
-                let edge = source
-                    .index()
-                    .and_then(|k| Some((*plan.keys.get(k.checked_sub(1)?)?, *plan.keys.get(k)?)));
-                let left = opts.time_limit_s - started.elapsed().as_secs_f64();
-                match edge {
-                    Some(e)
-                        if opts.forbidden.len() < MAX_REJECTED_MANOEUVRES
-                            && left > 0.0
-                            && !opts.forbidden.contains(&e) =>
-                    {
-                        opts.forbidden.push(e);
-                        opts.time_limit_s = left;
-                    }
-                    _ => return Err(RunJobError::Motion { scenario: name, source }),
-                }
-            }
+            Err(RunJobError::Motion { scenario: name, source }) => (name, source),
             Err(e) => return Err(e),
+        };
+        let edge = source
+            .index()
+            .and_then(|k| Some((*plan.keys.get(k.checked_sub(1)?)?, *plan.keys.get(k)?)));
+        let original = first.take().unwrap_or(RunJobError::Motion { scenario: name, source });
+        let Some(e) = edge.filter(|e| {
+            retry.forbidden.len() < MAX_REJECTED_MANOEUVRES && !retry.forbidden.contains(e)
+        }) else {
+            return Err(original);
+        };
+        retry.forbidden.push(e);
+        match plan::run(scenario, &robot, &retry) {
+            Ok(p) => {
+                planning_time_s += p.planning_time_s;
+                plan = p;
+                first = Some(original);
+            }
+            Err(_) => return Err(original),
         }
     }
 }

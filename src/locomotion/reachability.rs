@@ -63,6 +63,26 @@ pub const FEET_REACH_M: f64 = 1.0;
 /// Link radius between admissible cells, cells.
 pub const LINK_CELLS: isize = 2;
 
+/// A fixed-size bit set: one bit per (cell, orientation), 32 MB at the 4 M-cell map
+/// limit with 64 orientations.
+struct Bits(Vec<u64>);
+
+impl Bits {
+    fn new(n: usize) -> Self {
+        Self(vec![0; n.div_ceil(64)])
+    }
+
+    #[inline]
+    fn get(&self, k: usize) -> bool {
+        self.0[k / 64] >> (k % 64) & 1 == 1
+    }
+
+    #[inline]
+    fn set(&mut self, k: usize) {
+        self.0[k / 64] |= 1 << (k % 64);
+    }
+}
+
 /// Per cell, the largest value within `r` cells along each axis (cells off the grid
 /// ignored): two sliding-window passes.
 fn window_max(v: &[f64], nx: usize, ny: usize, r: usize) -> Vec<f64> {
@@ -150,13 +170,19 @@ impl BaseRegions {
                     HIP_BAND_X.iter().any(|dx| {
                         HIP_BAND_Y.iter().any(|dy| {
                             let (bx, by) = (hp[0] - hp[0].signum() * dx, hp[1] + dy);
+                            // Unknown or off the map: `legs_clear` lets it pass too.
                             legs.height_at_cell(x + c * bx - s * by, y + s * bx + c * by)
-                                .is_some_and(|h| h <= top + HIP_RISE_M)
+                                .is_none_or(|h| h <= top + HIP_RISE_M)
                         })
                     })
                 })
         };
-        let ok: Vec<bool> = (0..nx * ny * no).map(|n| admissible(n / no, n % no)).collect();
+        let mut ok = Bits::new(nx * ny * no);
+        for n in 0..nx * ny * no {
+            if admissible(n / no, n % no) {
+                ok.set(n);
+            }
+        }
         let Some(g) = (|| {
             let (i, j) = (usize::try_from(goal.0).ok()?, usize::try_from(goal.1).ok()?);
             (i < nx && j < ny).then_some(j * nx + i)
@@ -166,42 +192,44 @@ impl BaseRegions {
         // Flood from the goal cell's admissible orientations: linked are the same
         // orientation at most LINK_CELLS away along each axis, and the neighbouring
         // orientations in the same cell (a turn on the spot).
-        let mut seen = vec![false; nx * ny * no];
-        let mut queue: Vec<usize> = (0..no).map(|o| g * no + o).filter(|&n| ok[n]).collect();
+        let mut seen = Bits::new(nx * ny * no);
+        let mut queue: Vec<usize> = (0..no).map(|o| g * no + o).filter(|&n| ok.get(n)).collect();
         if queue.is_empty() {
             return Self::off();
         }
         for &n in &queue {
-            seen[n] = true;
+            seen.set(n);
         }
         while let Some(n) = queue.pop() {
             let (k, o) = (n / no, n % no);
             let (i, j) = ((k % nx) as isize, (k / nx) as isize);
             for o2 in [(o + 1) % no, (o + no - 1) % no] {
                 let m = k * no + o2;
-                if ok[m] && !seen[m] {
-                    seen[m] = true;
+                if ok.get(m) && !seen.get(m) {
+                    seen.set(m);
                     queue.push(m);
                 }
             }
             for b in (j - LINK_CELLS).max(0)..=(j + LINK_CELLS).min(ny as isize - 1) {
                 for a in (i - LINK_CELLS).max(0)..=(i + LINK_CELLS).min(nx as isize - 1) {
                     let m = (b as usize * nx + a as usize) * no + o;
-                    if ok[m] && !seen[m] {
-                        seen[m] = true;
+                    if ok.get(m) && !seen.get(m) {
+                        seen.set(m);
                         queue.push(m);
                     }
                 }
             }
         }
         // Per cell: reaches the goal with some orientation, cannot, or not admissible.
-        let mut region = vec![NONE; nx * ny];
-        for k in 0..nx * ny {
-            let any_ok = (0..no).any(|o| ok[k * no + o]);
-            if any_ok {
-                region[k] = u32::from(!(0..no).any(|o| seen[k * no + o]));
-            }
-        }
+        let region: Vec<u32> = (0..nx * ny)
+            .map(|k| {
+                if (0..no).any(|o| ok.get(k * no + o)) {
+                    u32::from(!(0..no).any(|o| seen.get(k * no + o)))
+                } else {
+                    NONE
+                }
+            })
+            .collect();
         let regions = 1 + usize::from(region.contains(&1));
         Self { nx, goal_region: Some(0), region, regions }
     }

@@ -332,10 +332,17 @@ impl Expander<'_> {
                 let pose =
                     Pose2 { x: p.base_position[0], y: p.base_position[1], theta: p.base_rpy[2] };
                 let xy = self.maps.neutral_feet(&pose);
+                // The feet on the ground under them, the base raised with the highest
+                // foot's rise over the interpolation (as the executor's drive runs do):
+                // a foot crossing a strip of bump between two lattice poses shortens no
+                // leg below its planned height.
+                let mut rise = 0.0_f64;
                 for (f, w) in p.feet.iter_mut().zip(xy) {
                     let z = self.maps.height_at(w[0], w[1]).unwrap_or(f[2]);
+                    rise = rise.max(z - f[2]);
                     *f = [w[0], w[1], z];
                 }
+                p.base_position[2] += rise;
             }
             let e = evaluate(self.robot, self.model, &p, o.standing.reach_margin_m)
                 .and_then(|e| {
@@ -893,7 +900,11 @@ pub fn expand_path(
             theta: ex.cur.base_rpy[2],
         };
         let p = ex.driving(&pose)?;
-        ex.push(PathKind::Drive, &[(Phase::Lower, None, p)])?;
+        // Where the driving posture does not fit (the planner admitted the goal standing),
+        // the robot finishes standing.
+        if check.posture_ok(&p, maps, maps.leg_terrain()).is_ok() {
+            ex.push(PathKind::Drive, &[(Phase::Lower, None, p)])?;
+        }
     }
     let min_keyframe = ex.keys.iter().map(|k| k.margin_m).fold(f64::INFINITY, f64::min);
     Ok(DetailedPath {

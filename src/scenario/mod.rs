@@ -382,7 +382,10 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
     if let Some(c) = &f.class
         && (c.is_empty() || !c.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_'))
     {
-        return Err(("class".into(), format!("`{c}` must be a non-empty word of a-z, 0-9 and _")));
+        return Err((
+            "class".into(),
+            format!("`{c}` must be a non-empty word of letters, digits and _"),
+        ));
     }
     positive("expect.timeout_s", e.timeout_s)?;
     Ok(())

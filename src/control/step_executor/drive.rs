@@ -59,7 +59,8 @@ impl StepExecutor {
         let time = obs.time;
         let out = follower.update(obs.base, dt);
         if out.status == FollowerStatus::Finished {
-            self.cmd = self.keys[last].posture();
+            // Where the wheels rest, as during the run: no jump into the next segment.
+            self.cmd = self.on_wheel_rest_heights(self.keys[last].posture(), obs);
             self.advance(last + 1, time);
             return self.hold();
         }
