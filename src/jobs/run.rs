@@ -281,6 +281,48 @@ pub struct RunSummary {
     pub events: Vec<MonitorEvent>,
 }
 
+impl RunSummary {
+    /// The summary of a run of `scenario` that executed nothing: every count zero, no
+    /// margin measured (infinite), nothing passed yet.
+    pub fn not_run(scenario: &str) -> Self {
+        Self {
+            scenario: scenario.to_owned(),
+            passed: false,
+            reached_goal: false,
+            goal_position_error_m: 0.0,
+            goal_heading_error_rad: 0.0,
+            sim_time_s: 0.0,
+            wall_time_s: 0.0,
+            real_time_factor: 0.0,
+            planning_time_s: 0.0,
+            plan_cost: 0.0,
+            plan_steps: 0,
+            steps_executed: 0,
+            steps_planned: 0,
+            steps_aborted: 0,
+            replans: 0,
+            keyframes: 0,
+            step_margins: Vec::new(),
+            executor_events: Vec::new(),
+            failure: None,
+            failure_kind: None,
+            push: None,
+            min_stability_margin_m: f64::INFINITY,
+            min_instant_margin_m: f64::INFINITY,
+            static_violation_s: 0.0,
+            worst_static_violation_m: 0.0,
+            tipped: false,
+            body_collisions: Vec::new(),
+            max_tracking_error_m: 0.0,
+            mean_tracking_error_m: 0.0,
+            max_pitch_deg: 0.0,
+            max_tilt_deg: 0.0,
+            expectations: Vec::new(),
+            events: Vec::new(),
+        }
+    }
+}
+
 fn expectations(scenario: &Scenario, s: &RunSummary) -> Vec<ExpectationResult> {
     let e = &scenario.expect;
     let mut out = Vec::new();
@@ -480,40 +522,14 @@ fn unexecuted(
     };
     let planning_time_s = wall.elapsed().as_secs_f64();
     let mut summary = RunSummary {
-        scenario: scenario.name.clone(),
-        passed: false,
-        reached_goal: false,
         goal_position_error_m: (scenario.start.x - scenario.goal.x)
             .hypot(scenario.start.y - scenario.goal.y),
         goal_heading_error_rad: wrap_angle(scenario.start.theta - scenario.goal.theta),
-        sim_time_s: 0.0,
         wall_time_s: planning_time_s,
-        real_time_factor: 0.0,
         planning_time_s,
-        plan_cost: 0.0,
-        plan_steps: 0,
-        steps_executed: 0,
-        steps_planned: 0,
-        steps_aborted: 0,
-        replans: 0,
-        keyframes: 0,
-        step_margins: Vec::new(),
-        executor_events: Vec::new(),
         failure: Some(chain(&e)),
         failure_kind: Some(kind),
-        push: None,
-        min_stability_margin_m: f64::INFINITY,
-        min_instant_margin_m: f64::INFINITY,
-        static_violation_s: 0.0,
-        worst_static_violation_m: 0.0,
-        tipped: false,
-        body_collisions: Vec::new(),
-        max_tracking_error_m: 0.0,
-        mean_tracking_error_m: 0.0,
-        max_pitch_deg: 0.0,
-        max_tilt_deg: 0.0,
-        expectations: Vec::new(),
-        events: Vec::new(),
+        ..RunSummary::not_run(&scenario.name)
     };
     summary.expectations = expectations(scenario, &summary);
     summary.passed = summary.expectations.iter().all(|e| e.passed);

@@ -523,20 +523,10 @@ fn in_sub(origin: [f64; 2], yaw_deg: f64, p: [f64; 2]) -> [f64; 2] {
     [c * dx + s * dy, -s * dx + c * dy]
 }
 
-/// Distance from `p` to the segment a–b.
-fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
-}
-
 fn polyline_distance(p: [f64; 2], way: &[[f64; 2]]) -> f64 {
-    way.windows(2).map(|w| segment_distance(p, w[0], w[1])).fold(f64::INFINITY, f64::min)
+    way.windows(2)
+        .map(|w| crate::stability::segment_distance(p, w[0], w[1]))
+        .fold(f64::INFINITY, f64::min)
 }
 
 fn polyline_length(way: &[[f64; 2]]) -> f64 {
