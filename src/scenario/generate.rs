@@ -870,7 +870,7 @@ fn stairs(rng: &mut Rng) -> Result<Course, Reject> {
     b.param("mid_landing_after", mid.map_or(0.0, |m| f64::from(m.0)));
     b.param("walls", if walls { 1.0 } else { 0.0 });
     b.param("yaw_deg", yaw);
-    match mid {
+    let (label, start) = match mid {
         Some((k1, depth)) => {
             b.add_stairs(
                 format!("lower flight: steps 1 to {k1}, then the intermediate landing"),
@@ -882,30 +882,13 @@ fn stairs(rng: &mut Rng) -> Result<Course, Reject> {
                 depth,
                 0.0,
             );
-            // Steps 1..k1 of this primitive lie under the lower flight (lower than it),
-            // so the union is the lower flight, the landing, then steps k1+1.. .
-            b.add_stairs(
-                format!("upper flight: steps {} to {steps} and the top landing", k1 + 1),
-                [depth, 0.0],
-                width,
-                steps,
-                tread,
-                rise,
-                landing,
-                0.0,
-            );
+            // Steps 1..k1 of the full flight below lie under the lower flight (lower
+            // than it), so the union is the lower flight, the landing, then steps k1+1.. .
+            (format!("upper flight: steps {} to {steps} and the top landing", k1 + 1), [depth, 0.0])
         }
-        None => b.add_stairs(
-            "the flight and its top landing".into(),
-            [0.0, 0.0],
-            width,
-            steps,
-            tread,
-            rise,
-            landing,
-            0.0,
-        ),
-    }
+        None => ("the flight and its top landing".into(), [0.0, 0.0]),
+    };
+    b.add_stairs(label, start, width, steps, tread, rise, landing, 0.0);
     let top = f64::from(steps) * rise;
     if walls {
         let h = round_to(top + 0.6, 2);
