@@ -42,6 +42,7 @@
 use super::lattice::Lattice;
 use crate::cost::{CostMaps, DiscMaxLayer};
 use crate::robot::RobotDescription;
+use crate::terrain::HeightMap;
 
 /// Radius around each base circle centre whose terrain the base must clear, m.
 pub const BODY_DISC_M: f64 = 0.2;
@@ -83,27 +84,6 @@ impl Bits {
     }
 }
 
-/// Per cell, the largest value within `r` cells along each axis (cells off the grid
-/// ignored): two sliding-window passes.
-fn window_max(v: &[f64], nx: usize, ny: usize, r: usize) -> Vec<f64> {
-    let mut rows = vec![f64::NEG_INFINITY; nx * ny];
-    for j in 0..ny {
-        for i in 0..nx {
-            let (a, b) = (i.saturating_sub(r), (i + r).min(nx - 1));
-            rows[j * nx + i] =
-                v[j * nx + a..=j * nx + b].iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        }
-    }
-    let mut out = vec![f64::NEG_INFINITY; nx * ny];
-    for j in 0..ny {
-        let (a, b) = (j.saturating_sub(r), (j + r).min(ny - 1));
-        for i in 0..nx {
-            out[j * nx + i] = (a..=b).map(|jj| rows[jj * nx + i]).fold(f64::NEG_INFINITY, f64::max);
-        }
-    }
-    out
-}
-
 /// "Not admissible".
 const NONE: u32 = u32::MAX;
 
@@ -135,14 +115,18 @@ impl BaseRegions {
         let (nx, ny) = hm.dims();
         let res = hm.resolution();
         // Highest standable ground near each cell (a square window holding the disc of
-        // FEET_REACH_M: a larger window only weakens the test).
+        // FEET_REACH_M: a larger window only weakens the test); not standable = unknown.
         let standable: Vec<f64> = (0..nx * ny)
             .map(|k| match (maps.foot_cost_cell(k % nx, k / nx).finite(), hm.as_slice()[k]) {
                 (Some(_), h) if h.is_finite() => h,
-                _ => f64::NEG_INFINITY,
+                _ => f64::NAN,
             })
             .collect();
-        let h_loc = window_max(&standable, nx, ny, (FEET_REACH_M / res).ceil() as usize);
+        let Ok(standable) = HeightMap::new(hm.origin(), res, nx, ny, standable) else {
+            return Self::off();
+        };
+        let h_loc = standable.dilated_max((FEET_REACH_M / res).ceil() as usize);
+        let h_loc = h_loc.as_slice();
         let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
         let legs = maps.leg_terrain();
         let circles = robot.base_circle_centres_x(circle_radius_m);

@@ -308,11 +308,26 @@ impl HeightMap {
     /// around (i, j) here (NaN where none is known): what a body part of up to r cells'
     /// reach over a cell must clear, answered by one look-up.
     pub fn dilated_max(&self, r: usize) -> HeightMap {
+        // Separable: the max over the row window, then over the column window of those
+        // (O(r) per cell, not O(r²)). `f64::max` passes over NaN, so unknown cells drop
+        // out; a window with none known stays −∞ and becomes NaN.
+        let (nx, ny) = (self.nx, self.ny);
+        let mut rows = vec![f64::NEG_INFINITY; nx * ny];
+        for j in 0..ny {
+            for i in 0..nx {
+                let (a, b) = (i.saturating_sub(r), (i + r).min(nx - 1));
+                rows[j * nx + i] = self.data[j * nx + a..=j * nx + b]
+                    .iter()
+                    .copied()
+                    .fold(f64::NEG_INFINITY, f64::max);
+            }
+        }
         let mut out = self.clone();
-        for j in 0..self.ny {
-            for i in 0..self.nx {
-                let [x, y] = self.cell_center(i, j);
-                out.data[j * self.nx + i] = self.max_around(x, y, r).unwrap_or(f64::NAN);
+        for j in 0..ny {
+            let (a, b) = (j.saturating_sub(r), (j + r).min(ny - 1));
+            for i in 0..nx {
+                let m = (a..=b).map(|jj| rows[jj * nx + i]).fold(f64::NEG_INFINITY, f64::max);
+                out.data[j * nx + i] = if m.is_finite() { m } else { f64::NAN };
             }
         }
         out
@@ -580,6 +595,29 @@ mod tests {
         assert_eq!(hm.min_around(0.25, 0.15, 1), Some(1.0));
         assert_eq!(hm.min_around(0.05, 0.05, 0), Some(0.0));
         assert_eq!(hm.min_around(5.0, 5.0, 1), None);
+    }
+
+    #[test]
+    fn dilated_max_is_the_max_around_every_cell_unknown_cells_left_out() {
+        // The separable passes against the direct (2r + 1)² block, with unknown cells
+        // and a corner where none is known.
+        let mut hm = HeightMap::from_fn([0.0, 0.0], 0.1, 13, 9, |i, j| {
+            ((i * 37 + j * 11) % 17) as f64 * 0.01
+        })
+        .unwrap();
+        for (i, j) in [(4, 4), (5, 4), (0, 0), (1, 0), (0, 1), (1, 1), (12, 8)] {
+            hm.set(i, j, f64::NAN).unwrap();
+        }
+        for r in 0..4 {
+            let d = hm.dilated_max(r);
+            for j in 0..9 {
+                for i in 0..13 {
+                    let [x, y] = hm.cell_center(i, j);
+                    assert_eq!(d.get(i, j), hm.max_around(x, y, r), "r {r} ({i}, {j})");
+                }
+            }
+        }
+        assert_eq!(hm.dilated_max(0).get(0, 0), None);
     }
 
     #[test]
