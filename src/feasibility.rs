@@ -20,7 +20,8 @@
 //! ends.
 //!
 //! Stepping uses the standing rule of `motion::standing` (its step heights are what the
-//! planner's reach check and the generator's step candidates share).
+//! planner's reach check and the generator's step candidates share), and the planner runs
+//! the generator's own step check (`motion::expand::step_motion`) on the steps it admits.
 
 use crate::cost::CostMaps;
 use crate::geometry::Pose2;

@@ -41,7 +41,11 @@
 //!   also needs a CoM estimate (`motion::standing::com_estimate`: base body and legs
 //!   lumped, the robot standing by the rule) inside the support triangle of the other
 //!   three feet, with the partner wheel driven toward the centre as far as the generator
-//!   may (`Params::step_support_margin_m`): roll and a base shift align the rest.
+//!   may (`Params::step_support_margin_m`): roll and a base shift align the rest. That is
+//!   the cheap filter; a step that passes it must then pass the generator's own check
+//!   (`motion::expand::step_motion`: roll, wheel to centre, base shift, lift, swing,
+//!   place and back, every centimetre, with the CoM estimate and 3 mm of margin to
+//!   spare), so a planned step is one the generator expands.
 //! - *Which footholds count as a step.* A step must carry the foot *over* untraversable
 //!   terrain: its straight sagittal line crosses at least one cell of infinite foot cost.
 //!   A foothold reachable over finite cells only is a wheel drive (front foot forward /
@@ -91,8 +95,9 @@ use super::reachability::BaseRegions;
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
+use crate::motion::expand::{self, MotionOptions};
 use crate::motion::kinematics::hips_in_world;
-use crate::motion::standing::{StandingRule, com_estimate};
+use crate::motion::standing::{EstimatedCom, StandingRule, com_estimate};
 use crate::params::Params;
 use crate::planner::{Cost, FxBuild, SearchGraph};
 use crate::robot::ik::leg_ik;
@@ -213,7 +218,17 @@ pub struct HybridConfig {
     pub min_stability_margin_m: f64,
     /// Radius of the base's two circles (Sec. IV), m.
     pub base_circle_radius_m: f64,
+    /// The motion generator's constants, with which steps are checked
+    /// ([`expand::step_motion`]); its margin is the generator's plus
+    /// [`PLANNER_MARGIN_SLACK_M`].
+    pub motion: MotionOptions,
 }
+
+/// Margin the planner's step and wheel-move checks require beyond the generator's, m: the
+/// planner's CoM estimate ([`EstimatedCom`]) is MuJoCo's to a micrometre with the wheels
+/// level, but the roll of eqs. 6–8 is iterated to 3 mm of its target with either model,
+/// so the generator's roll may differ slightly from the planner's.
+pub const PLANNER_MARGIN_SLACK_M: f64 = 0.003;
 
 impl HybridConfig {
     /// From the paper's constants and the robot's neutral footprint; the shortest foot
@@ -239,6 +254,11 @@ impl HybridConfig {
             driving_leg_height_m: params.driving_leg_height_m,
             min_stability_margin_m: params.min_stability_margin_m,
             base_circle_radius_m: params.base_circle_radius_m,
+            motion: {
+                let mut m = MotionOptions::from_params(params);
+                m.min_margin_m += PLANNER_MARGIN_SLACK_M;
+                m
+            },
         }
     }
 }
@@ -308,6 +328,9 @@ pub struct HybridGraph<'c> {
     /// footprint is entered from several predecessors, and each check runs the standing
     /// rule's IK.
     standable: HashMap<(i16, i16, u8, FootOffsets), bool, FxBuild>,
+    /// [`Self::step_feasible`] by the state a step starts from, the leg and its new
+    /// offset: ARA* expands a state again in each iteration.
+    step_checks: HashMap<(PoseKey, u8, i8), bool, FxBuild>,
 }
 
 /// A lattice state by what it means, not by this graph's footprint ids: cell,
@@ -427,6 +450,7 @@ impl<'c> HybridGraph<'c> {
             step_bound,
             heuristic_setup,
             standable: HashMap::default(),
+            step_checks: HashMap::default(),
         })
     }
 
@@ -603,31 +627,44 @@ impl<'c> HybridGraph<'c> {
         self.side_length(o, true) >= min_side && self.side_length(o, false) >= min_side
     }
 
-    /// Whether the step of leg `leg` from feet `feet` (state `s`) to the foot at
-    /// `post` (x, y, ground z) stays within reach while the foot is carried (the
-    /// standing rule's [`StandingRule::step_heights`]).
-    /// Returns the first (tallest) such leg height.
-    fn step_in_reach(
-        &self,
-        s: LatticeState,
-        feet: &Feet,
-        leg: usize,
-        post: [f64; 3],
-    ) -> Option<f64> {
+    /// Whether the step of leg `leg` from feet `feet` (state `s`) to the foot at `post`
+    /// (x, y, ground z) is one the motion generator expands:
+    /// - it stays within reach while the foot is carried (the standing rule's
+    ///   [`StandingRule::step_heights`]; the first, tallest height is the stance),
+    /// - the CoM estimate lies in the support triangle ([`Self::step_supported`]), a cheap
+    ///   filter before
+    /// - the generator's own check ([`expand::step_motion`]) from the standing posture of
+    ///   the shared rule, at every sample, with the CoM estimate ([`EstimatedCom`]) and
+    ///   [`PLANNER_MARGIN_SLACK_M`] to spare.
+    fn step_feasible(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
         let pose = self.lattice.pose(s);
-        self.config
-            .standing
-            .step_heights(
-                &self.robot,
-                self.maps.heights(),
-                self.maps.leg_terrain(),
-                Self::feet_xyz(feet),
-                leg,
-                post,
-                [pose.x, pose.y],
-                pose.theta,
-            )
-            .next()
+        let (robot, maps, rule) = (&self.robot, self.maps, &self.config.standing);
+        let pre_feet = Self::feet_xyz(feet);
+        let xy = [pose.x, pose.y];
+        let mut heights = rule.step_heights(
+            robot,
+            maps.heights(),
+            maps.leg_terrain(),
+            pre_feet,
+            leg,
+            post,
+            xy,
+            pose.theta,
+        );
+        let Some(first) = heights.next() else {
+            return false;
+        };
+        if !self.step_supported(s, feet, leg, post, first) {
+            return false;
+        }
+        let Ok((pre, _)) = rule.stand(robot, maps.leg_terrain(), pre_feet, xy, pose.theta) else {
+            return false;
+        };
+        let mut model = EstimatedCom { robot };
+        let heights = std::iter::once(first).chain(heights);
+        let options = &self.config.motion;
+        expand::step_motion(robot, maps, &mut model, options, pre, Leg::ALL[leg], post, heights)
+            .is_ok()
     }
 
     /// Whether state `t` (footprint offsets `o`) may be entered; its body cost for
@@ -727,9 +764,17 @@ impl<'c> HybridGraph<'c> {
         candidates.into_iter().find_map(|(_, d, cost, foothold)| {
             let mut o2 = *o;
             o2[leg] = (i32::from(o[leg]) + d) as i8;
-            let height = self.step_in_reach(s, feet, leg, foothold)?;
-            (self.step_supported(s, feet, leg, foothold, height) && self.target_ok(s, &o2))
-                .then_some((o2, cost))
+            let key = ((s.i, s.j, s.theta, *o), leg as u8, o2[leg]);
+            let known = self.step_checks.get(&key).copied();
+            if !self.target_ok(s, &o2) {
+                return None;
+            }
+            let ok = known.unwrap_or_else(|| {
+                let ok = self.step_feasible(s, feet, leg, foothold);
+                self.step_checks.insert(key, ok);
+                ok
+            });
+            ok.then_some((o2, cost))
         })
     }
 

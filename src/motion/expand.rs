@@ -45,6 +45,15 @@
 //! ±2.5 to ±20 cm with every wheel and roll choice. The first candidate whose every point
 //! holds is taken; otherwise [`MotionError::Step`] names the step, the leg and the best
 //! margin reached.
+//!
+//! **The planner runs the same check** ([`step_motion`], [`StepSearch::Planner`]): the
+//! first two heights with full wheel alignment and every roll and shift fraction, a
+//! subset of the generator's candidates, from the shared rule's standing posture at the
+//! planned pose ([`StandingRule::stand`]). The generator settles into that posture before
+//! every step and wheel move (a `stand_up` keyframe where the manoeuvre before left the
+//! base elsewhere), so a step the planner admits meets a candidate here that holds; only
+//! the CoM model differs (the planner's estimate, MuJoCo's here), and the planner keeps
+//! 3 mm of margin for that.
 
 use super::CenterOfMassModel;
 use super::keyframe::{DetailedPath, Keyframe, Phase};
@@ -61,7 +70,7 @@ use crate::params::Params;
 use crate::robot::{Leg, RobotDescription};
 
 /// Constants of the expansion.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MotionOptions {
     /// Minimum static stability margin at every keyframe and interpolated point, m.
     pub min_margin_m: f64,
@@ -214,7 +223,30 @@ struct Expander<'a> {
 /// A planned keyframe before checking.
 type Planned = (Phase, Option<Leg>, Posture);
 
-impl Expander<'_> {
+impl<'a> Expander<'a> {
+    /// An expander standing in posture `cur`, nothing expanded yet.
+    fn at(
+        robot: &'a RobotDescription,
+        maps: &'a CostMaps,
+        model: &'a mut dyn CenterOfMassModel,
+        o: &'a MotionOptions,
+        cur: Posture,
+    ) -> Self {
+        Self {
+            robot,
+            maps,
+            model,
+            o,
+            keys: Vec::new(),
+            cur,
+            time: 0.0,
+            samples: 0,
+            min_margin: f64::INFINITY,
+            min_three: f64::INFINITY,
+            index: 0,
+        }
+    }
+
     fn ground(&self, x: f64, y: f64) -> Result<f64, MotionError> {
         self.maps.height_at(x, y).ok_or(MotionError::UnknownTerrain { index: self.index, x, y })
     }
@@ -304,6 +336,19 @@ impl Expander<'_> {
             .map_err(|e| e.to_string())
     }
 
+    /// Checks one posture: the leg IK with the reach margin, thighs and shins clear of the
+    /// terrain, and the stability margin.
+    fn check_posture(&mut self, p: &Posture) -> Result<Evaluation, Infeasible> {
+        let o = self.o;
+        let e = evaluate(self.robot, self.model, p, o.standing.reach_margin_m).and_then(|e| {
+            o.standing.legs_clear(self.robot, self.maps.leg_terrain(), p, &e.joints).map(|()| e)
+        })?;
+        if e.margin < o.min_margin_m {
+            return Err(Infeasible::Margin { margin_m: e.margin, required_m: o.min_margin_m });
+        }
+        Ok(e)
+    }
+
     /// Checks the segment from `a` to `b` (interpolated points and `b`); `drive` keeps the
     /// feet in the neutral footprint under the moving base.
     fn check_segment(
@@ -344,19 +389,7 @@ impl Expander<'_> {
                 }
                 p.base_position[2] += rise;
             }
-            let e = evaluate(self.robot, self.model, &p, o.standing.reach_margin_m)
-                .and_then(|e| {
-                    o.standing
-                        .legs_clear(self.robot, self.maps.leg_terrain(), &p, &e.joints)
-                        .map(|()| e)
-                })
-                .map_err(|e| (t, Infeasible::Posture(e)))?;
-            if e.margin < o.min_margin_m {
-                return Err((
-                    t,
-                    Infeasible::Margin { margin_m: e.margin, required_m: o.min_margin_m },
-                ));
-            }
+            let e = self.check_posture(&p).map_err(|cause| (t, cause))?;
             min_margin = min_margin.min(e.margin);
             if p.contact.iter().filter(|&&c| c).count() == 3 {
                 min_three = min_three.min(e.margin);
@@ -384,6 +417,16 @@ impl Expander<'_> {
         &mut self,
         seq: &[Planned],
     ) -> Result<(Vec<Keyframe>, f64, f64, usize), SegmentFailure> {
+        // The keyframes first: a candidate that fails mostly fails at one of them, and
+        // each costs one sample where its segment costs one per centimetre. The verdict
+        // is the same: every keyframe is its segment's last sample.
+        for &(phase, _, p) in seq {
+            self.check_posture(&p).map_err(|cause| SegmentFailure {
+                phase: phase.name(),
+                percent: 100.0,
+                cause,
+            })?;
+        }
         let mut from = self.cur;
         let mut t = self.time;
         let mut out = Vec::with_capacity(seq.len());
@@ -465,7 +508,7 @@ impl Expander<'_> {
         roll_fraction: f64,
         shift: Shift,
     ) -> Result<Vec<Planned>, String> {
-        let o = self.o.clone();
+        let o = *self.o;
         let i = leg.index();
         let j = leg.same_side_partner().index();
         let yaw = self.cur.base_rpy[2];
@@ -615,52 +658,58 @@ impl Expander<'_> {
         Ok(seq)
     }
 
-    fn expand_step(&mut self, leg: Leg, post_xy: [f64; 2]) -> Result<(), MotionError> {
-        let post_foot = [post_xy[0], post_xy[1], self.ground(post_xy[0], post_xy[1])?];
+    /// Expands a step of `leg` to `post_foot` from the current posture with the
+    /// candidates of `search`, committing the first that holds.
+    fn expand_step(
+        &mut self,
+        leg: Leg,
+        post_foot: [f64; 3],
+        search: StepSearch,
+    ) -> Result<(), MotionError> {
         // The heights of the shared rule at which the step is within reach (what the
         // planner checked), then two taller stances (the soft constraint is a minimum).
-        let i = leg.index();
-        let (pre, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
         let rule = self.o.standing;
-        let mut heights = rule
+        let (pre, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
+        let heights = rule
             .step_heights(
                 self.robot,
                 self.maps.heights(),
                 self.maps.leg_terrain(),
                 pre,
-                i,
+                leg.index(),
                 post_foot,
                 xy,
                 yaw,
             )
+            .chain([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1])
             .collect::<Vec<_>>();
-        heights.extend([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1]);
+        self.expand_step_at(leg, post_foot, search, heights.into_iter())
+    }
+
+    /// [`Self::expand_step`] at the leg heights `heights` (lazily: the planner's check
+    /// takes the next height only when every candidate at the ones before failed).
+    fn expand_step_at(
+        &mut self,
+        leg: Leg,
+        post_foot: [f64; 3],
+        search: StepSearch,
+        heights: impl Iterator<Item = f64>,
+    ) -> Result<(), MotionError> {
+        let i = leg.index();
+        let pre = self.cur.feet;
+        let rule = self.o.standing;
         // The same for every candidate (what `step_heights` checked the swing at).
         let swing_z = rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
-        // First the paper's sequence (a base shift only where the wheel was hindered), in
-        // full, half or none of each alignment; then base shifts of fixed length with
-        // every wheel and roll choice (the CoM may need to go where the wheel cannot
-        // take the support triangle, e.g. sideways out of a narrow triangle).
-        let mut candidates = Vec::new();
-        for pass in 0..2 {
-            for &h in &heights {
-                for wf in [1.0, 0.5, 0.0, f64::INFINITY] {
-                    for rf in [1.0, 0.5, 0.0] {
-                        if pass == 0 {
-                            for f in [1.0, 0.5, 0.0] {
-                                candidates.push((h, wf, rf, Shift::Remainder(f)));
-                            }
-                        } else {
-                            for m in [0.025, 0.05, 0.1, 0.15, 0.2, -0.025, -0.05, -0.1, -0.15, -0.2]
-                            {
-                                candidates.push((h, wf, rf, Shift::Fixed(m)));
-                            }
-                        }
-                    }
-                }
-            }
-        }
         let mut best: (f64, String) = (f64::NEG_INFINITY, "no candidate".to_owned());
+        let mut previous: Option<Vec<Planned>> = None;
+        let candidates: Box<dyn Iterator<Item = (f64, f64, f64, Shift)>> = match search {
+            StepSearch::Planner => {
+                Box::new(heights.take(PLANNER_STEP_HEIGHTS).flat_map(|h| {
+                    PLANNER_ALIGNMENTS.map(|(rf, f)| (h, 1.0, rf, Shift::Remainder(f)))
+                }))
+            }
+            StepSearch::Full => Box::new(full_candidates(&heights.collect::<Vec<_>>()).into_iter()),
+        };
         for (h, wf, rf, shift) in candidates {
             let seq = match self.step_candidate(leg, post_foot, swing_z, h, wf, rf, shift) {
                 Ok(s) => s,
@@ -671,6 +720,11 @@ impl Expander<'_> {
                     continue;
                 }
             };
+            // Alignments that came out the same (no shift where the wheel was not
+            // hindered) are checked once.
+            if previous.as_ref() == Some(&seq) {
+                continue;
+            }
             match self.trial(&seq) {
                 Ok((k, mm, m3, s)) => {
                     self.commit(k, mm, m3, s);
@@ -686,6 +740,7 @@ impl Expander<'_> {
                     }
                 }
             }
+            previous = Some(seq);
         }
         Err(MotionError::Step {
             index: self.index,
@@ -695,6 +750,123 @@ impl Expander<'_> {
             reason: best.1,
         })
     }
+
+    /// Moves the base, all feet down, to the shared rule's standing posture over the
+    /// current feet at `pose` ([`StandingRule::stand`]) if it is not there: every step and
+    /// wheel move starts from that posture, the one the planner checks it from
+    /// ([`step_motion`], for steps), whatever the manoeuvre before left (a roll-back
+    /// at another leg height, a base re-centred on its feet).
+    fn settle(&mut self, kind: PathKind, pose: &Pose2) -> Result<(), MotionError> {
+        let p = self.standing_fallback(self.cur.feet, [pose.x, pose.y], pose.theta).map_err(
+            |reason| MotionError::Manoeuvre { index: self.index, kind: kind_name(kind), reason },
+        )?;
+        if p != self.cur {
+            self.push(kind, &[(Phase::StandUp, None, p)])?;
+        }
+        Ok(())
+    }
+
+    /// The wheel move of one foot to `foot` (x, y on the ground), the base standing by the
+    /// shared rule at its current place.
+    fn expand_wheel_move(
+        &mut self,
+        kind: PathKind,
+        leg: Leg,
+        foot: [f64; 2],
+    ) -> Result<(), MotionError> {
+        let mut feet = self.cur.feet;
+        feet[leg.index()] = [foot[0], foot[1], self.ground(foot[0], foot[1])?];
+        let (xy, yaw) = (self.xy(), self.cur.base_rpy[2]);
+        let p = self.standing_fallback(feet, xy, yaw).map_err(|reason| MotionError::Manoeuvre {
+            index: self.index,
+            kind: kind_name(kind),
+            reason,
+        })?;
+        self.push(kind, &[(Phase::WheelMove, Some(leg), p)])
+    }
+}
+
+/// Which step candidates the expansion tries (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepSearch {
+    /// The planner's: the first [`PLANNER_STEP_HEIGHTS`] heights of the shared rule, the
+    /// partner wheel's full alignment, no, full or half roll, and none, all or half of
+    /// the remaining base shift. Every one of them is also a [`StepSearch::Full`]
+    /// candidate, so a step the planner admits is one the generator expands.
+    Planner,
+    /// The generator's: every height of the rule and two taller, every alignment, then
+    /// fixed base shifts.
+    Full,
+}
+
+/// Leg heights of the shared rule the planner's step check tries. On the paper's
+/// scenarios and generated step courses the generator's steps held at the first or second.
+pub const PLANNER_STEP_HEIGHTS: usize = 2;
+
+/// The generator's candidates (leg height, wheel fraction, roll fraction, shift) at
+/// `heights`, in the order tried (see the module docs).
+fn full_candidates(heights: &[f64]) -> Vec<(f64, f64, f64, Shift)> {
+    let mut out = Vec::new();
+    for pass in 0..2 {
+        for &h in heights {
+            for wf in [1.0, 0.5, 0.0, f64::INFINITY] {
+                for rf in [1.0, 0.5, 0.0] {
+                    if pass == 0 {
+                        for f in [1.0, 0.5, 0.0] {
+                            out.push((h, wf, rf, Shift::Remainder(f)));
+                        }
+                    } else {
+                        for m in [0.025, 0.05, 0.1, 0.15, 0.2, -0.025, -0.05, -0.1, -0.15, -0.2] {
+                            out.push((h, wf, rf, Shift::Fixed(m)));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The planner's (roll fraction, base-shift fraction) pairs, in order: every pair of the
+/// generator's first pass with the partner wheel fully aligned.
+const PLANNER_ALIGNMENTS: [(f64, f64); 9] = [
+    (0.0, 0.0),
+    (0.0, 1.0),
+    (1.0, 0.0),
+    (1.0, 1.0),
+    (0.5, 0.0),
+    (0.5, 1.0),
+    (0.0, 0.5),
+    (1.0, 0.5),
+    (0.5, 0.5),
+];
+
+/// The planner's check of a step (`locomotion::hybrid`): whether the expansion finds a
+/// stable motion among the [`StepSearch::Planner`] candidates for a step of `leg` from
+/// posture `pre` (the shared rule's standing posture, [`StandingRule::stand`]) to
+/// `post_foot`, with the CoM of `model` and margins of `options`. `heights` are the
+/// shared rule's step heights for this step ([`StandingRule::step_heights`], which the
+/// planner has begun to draw on): the generator computes the same from `pre`.
+///
+/// # Errors
+/// The expansion's [`MotionError::Step`] when no candidate holds.
+#[allow(clippy::too_many_arguments)]
+pub fn step_motion(
+    robot: &RobotDescription,
+    maps: &CostMaps,
+    model: &mut dyn CenterOfMassModel,
+    options: &MotionOptions,
+    pre: Posture,
+    leg: Leg,
+    post_foot: [f64; 3],
+    heights: impl Iterator<Item = f64>,
+) -> Result<(), MotionError> {
+    Expander::at(robot, maps, model, options, pre).expand_step_at(
+        leg,
+        post_foot,
+        StepSearch::Planner,
+        heights,
+    )
 }
 
 /// The longitudinal base shift of a step candidate.
@@ -732,24 +904,13 @@ pub fn expand_path(
     options: &MotionOptions,
 ) -> Result<DetailedPath, MotionError> {
     let first = path.first().ok_or(MotionError::EmptyPath)?;
-    let mut ex = Expander {
-        robot,
-        maps,
-        model,
-        o: options,
-        keys: Vec::new(),
-        cur: Posture {
-            base_position: [first.pose.x, first.pose.y, 0.0],
-            base_rpy: [0.0, 0.0, first.pose.theta],
-            feet: [[0.0; 3]; 4],
-            contact: [true; 4],
-        },
-        time: 0.0,
-        samples: 0,
-        min_margin: f64::INFINITY,
-        min_three: f64::INFINITY,
-        index: 0,
+    let placeholder = Posture {
+        base_position: [first.pose.x, first.pose.y, 0.0],
+        base_rpy: [0.0, 0.0, first.pose.theta],
+        feet: [[0.0; 3]; 4],
+        contact: [true; 4],
     };
+    let mut ex = Expander::at(robot, maps, model, options, placeholder);
     let start = ex.driving(&first.pose)?;
     ex.cur = start;
     let e = evaluate(robot, ex.model, &start, options.standing.reach_margin_m)
@@ -852,7 +1013,10 @@ pub fn expand_path(
                 };
                 match (el.kind, el.leg) {
                     (PathKind::Step, Some(leg)) => {
-                        ex.expand_step(leg, el.feet[leg.index()])?;
+                        ex.settle(el.kind, &path[k - 1].pose)?;
+                        let f = el.feet[leg.index()];
+                        let post_foot = [f[0], f[1], ex.ground(f[0], f[1])?];
+                        ex.expand_step(leg, post_foot, StepSearch::Full)?;
                         steps += 1;
                     }
                     (PathKind::BaseShift, _) => {
@@ -880,12 +1044,8 @@ pub fn expand_path(
                         ex.push(el.kind, &seq)?;
                     }
                     (_, Some(leg)) => {
-                        let mut feet = ex.cur.feet;
-                        let f = el.feet[leg.index()];
-                        feet[leg.index()] = [f[0], f[1], ex.ground(f[0], f[1])?];
-                        let (xy, yaw) = (ex.xy(), ex.cur.base_rpy[2]);
-                        let p = ex.standing_fallback(feet, xy, yaw).map_err(bad)?;
-                        ex.push(el.kind, &[(Phase::WheelMove, Some(leg), p)])?;
+                        ex.settle(el.kind, &path[k - 1].pose)?;
+                        ex.expand_wheel_move(el.kind, leg, el.feet[leg.index()])?;
                     }
                     (_, None) => return Err(bad("no leg named".to_owned())),
                 }

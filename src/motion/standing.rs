@@ -19,11 +19,12 @@
 //! - during a step, the stepping leg counts the higher of its two grounds (the foot must
 //!   clear it), and its foot must also be reachable at the swing height above both ends.
 
+use super::CenterOfMassModel;
 use super::kinematics::{Posture, PostureError, apply, pitch_from_feet, rotation, solve_legs};
 use crate::geometry::Pose2;
 use crate::params::Params;
 use crate::robot::RobotDescription;
-use crate::robot::ik::{knee_and_ankle, world_down};
+use crate::robot::ik::{knee_and_ankle, leg_fk, world_down};
 use crate::terrain::HeightMap;
 
 /// The parameters of the rule.
@@ -389,11 +390,53 @@ impl ReachProbe {
 /// [`PostureError`] if a leg cannot reach its foot.
 pub fn com_estimate(robot: &RobotDescription, p: &Posture) -> Result<[f64; 2], PostureError> {
     let joints = solve_legs(robot, p, 0.0)?;
-    let r = rotation(p.base_rpy);
-    let world = |b: [f64; 3]| apply(&r, p.base_position, b);
+    let c = lumped_com(robot, p.base_position, p.base_rpy, &joints, &p.feet);
+    Ok([c[0], c[1]])
+}
+
+/// [`com_estimate`]'s lumped masses as a [`CenterOfMassModel`]: the motion generator's
+/// checks, run by the planner without MuJoCo (`locomotion::hybrid`'s step and wheel-move
+/// checks). The foot mass sits at the wheel axle, which the leg's forward kinematics
+/// gives; its height (which only the roll of eqs. 6–8 uses) is the axle's.
+#[derive(Debug, Clone, Copy)]
+pub struct EstimatedCom<'r> {
+    /// The robot's kinematics and masses.
+    pub robot: &'r RobotDescription,
+}
+
+impl CenterOfMassModel for EstimatedCom<'_> {
+    fn com(
+        &mut self,
+        base_position: [f64; 3],
+        base_rpy: [f64; 3],
+        legs: &[[f64; 3]; 4],
+    ) -> [f64; 3] {
+        let r = rotation(base_rpy);
+        let rb = self.robot;
+        let axles: [[f64; 3]; 4] = std::array::from_fn(|i| {
+            let h = rb.hips[i];
+            let c = leg_fk(rb, legs[i], base_rpy[1]);
+            let contact = apply(&r, base_position, [h[0] + c[0], h[1], h[2] + c[1]]);
+            [contact[0], contact[1], contact[2] + rb.wheel_radius]
+        });
+        lumped_com(rb, base_position, base_rpy, legs, &axles)
+    }
+}
+
+/// The lumped-mass CoM (world, m): the body at its CoM, thighs and shins at their
+/// midpoints for joint angles `joints`, each foot's mass at `feet`.
+fn lumped_com(
+    robot: &RobotDescription,
+    base_position: [f64; 3],
+    base_rpy: [f64; 3],
+    joints: &[[f64; 3]; 4],
+    feet: &[[f64; 3]; 4],
+) -> [f64; 3] {
+    let r = rotation(base_rpy);
+    let world = |b: [f64; 3]| apply(&r, base_position, b);
     let body = world(robot.body_com);
     let [m_thigh, m_shin, m_foot] = robot.leg_segment_masses;
-    let mut c = [robot.body_mass * body[0], robot.body_mass * body[1]];
+    let mut c = body.map(|v| robot.body_mass * v);
     let mut total = robot.body_mass;
     for (i, q) in joints.iter().enumerate() {
         let h = robot.hips[i];
@@ -401,20 +444,17 @@ pub fn com_estimate(robot: &RobotDescription, p: &Posture) -> Result<[f64; 2], P
         let thigh = world([h[0] + knee[0] / 2.0, h[1], h[2] + knee[1] / 2.0]);
         let shin =
             world([h[0] + (knee[0] + ankle[0]) / 2.0, h[1], h[2] + (knee[1] + ankle[1]) / 2.0]);
-        for (m, x, y) in [
-            (m_thigh, thigh[0], thigh[1]),
-            (m_shin, shin[0], shin[1]),
-            (m_foot, p.feet[i][0], p.feet[i][1]),
-        ] {
-            c[0] += m * x;
-            c[1] += m * y;
+        for (m, x) in [(m_thigh, thigh), (m_shin, shin), (m_foot, feet[i])] {
+            for k in 0..3 {
+                c[k] += m * x[k];
+            }
             total += m;
         }
     }
     if total <= 0.0 {
-        return Ok([p.base_position[0], p.base_position[1]]);
+        return base_position;
     }
-    Ok([c[0] / total, c[1] / total])
+    c.map(|v| v / total)
 }
 
 /// Base origin height for the base at `rpy` such that the hip over the highest of `ground`

@@ -21,8 +21,11 @@ const REACH_SPARE_M: f64 = 0.001;
 
 /// Joint targets for `p` like `motion::kinematics::leg_joint_targets`, except that a foot
 /// beyond a leg's reach is pulled toward its hip (along the hip–ankle line) until the leg
-/// has `spare` m of reach left: the executor's corrections (landing offset, stabilising
-/// shift) may ask a few millimetres more than a posture planned at the reach limit has.
+/// has `spare` m of reach left, and a foot closer to its hip than the knee folds is pushed
+/// out along the same line until the knee has `spare` m of fold left: the executor's
+/// corrections (landing offset, stabilising shift, wheels resting on the height map under
+/// a driving posture whose knees fold nearly to their limit) may ask a few millimetres
+/// more than a posture planned at either limit has.
 ///
 /// # Errors
 /// [`IkError`] for a joint limit or non-finite input.
@@ -34,7 +37,11 @@ pub fn reachable_leg_targets(
     let local = contacts_in_base(robot, p);
     let pitch = p.base_rpy[1];
     let below = robot.foot_length + robot.wheel_radius;
-    let reach = robot.thigh_length + robot.shin_length - spare;
+    let (l1, l2) = (robot.thigh_length, robot.shin_length);
+    let reach = l1 + l2 - spare;
+    // Hip-to-ankle distance with the knee folded to its limit (law of cosines).
+    let knee_max = robot.joint_ranges[1].min.abs().min(robot.joint_ranges[1].max.abs());
+    let folded = (l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * knee_max.cos()).max(0.0).sqrt() + spare;
     let down = world_down(pitch);
     let mut q = [[0.0; 3]; 4];
     for leg in Leg::ALL {
@@ -42,8 +49,15 @@ pub fn reachable_leg_targets(
         let mut contact = [c[0], c[2]];
         let ankle = ankle_of_contact(robot, contact, pitch);
         let d = ankle[0].hypot(ankle[1]);
-        if d > reach {
-            let k = reach / d;
+        let target = if d > reach {
+            reach
+        } else if d < folded && d > 1e-9 {
+            folded
+        } else {
+            d
+        };
+        if target != d {
+            let k = target / d;
             contact = [ankle[0] * k + below * down[0], ankle[1] * k + below * down[1]];
         }
         q[leg.index()] = leg_ik(robot, leg, contact, pitch)?;
@@ -134,6 +148,25 @@ mod tests {
             (rolling_wheel_speed(&r, [0.1, 0.0], std::f64::consts::FRAC_PI_3) - 0.625).abs()
                 < 1e-12
         );
+    }
+
+    #[test]
+    fn a_foot_closer_than_the_folded_knee_is_pushed_out_along_the_hip_ankle_line() {
+        let r = robot();
+        let mut p = standing();
+        // Hip 0.45 m above the ground, ankle 0.27 m below the hip; raising the foot by
+        // 0.22 m puts the ankle 0.05 m below it. The knee folds to ±2.9 rad at most:
+        // hip to ankle √(2 · 0.25² · (1 + cos 2.9)) = 0.060251 m, so 0.05 is too close.
+        p.feet[0][2] += 0.22;
+        assert!(leg_joint_targets(&r, &p).is_err());
+        let q = reachable_leg_targets(&r, &p, 0.001).unwrap();
+        let c = leg_fk(&r, q[0], 0.0);
+        let ankle = [c[0], c[1] + r.foot_length + r.wheel_radius];
+        let folded = (2.0 * 0.0625 * (1.0 + 2.9f64.cos())).sqrt();
+        assert!((folded - 0.060251).abs() < 1e-6);
+        assert!((ankle[0].hypot(ankle[1]) - (folded + 0.001)).abs() < 1e-9, "{ankle:?}");
+        // Along the line: straight down, as the foot was.
+        assert!(ankle[0].abs() < 1e-9 && ankle[1] < 0.0, "{ankle:?}");
     }
 
     #[test]
