@@ -83,6 +83,7 @@
 //! proofs are in the `heuristic` module docs; `locomotion::tests` checks
 //! `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge.
 
+use super::cost_to_go::CostToGo;
 use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, edge_cost};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{StepBound, StepBoundParams};
@@ -302,12 +303,34 @@ pub struct HybridGraph<'c> {
     stats: ManoeuvreStats,
     /// The step-cost part of the heuristic (`heuristic`), built once per graph.
     step_bound: StepBound,
+    /// The driving and base-shift part of the heuristic (`cost_to_go`): a backward
+    /// Dijkstra over base cells, run lazily as far as the queries need.
+    cost_to_go: CostToGo,
     /// Time spent building `step_bound`.
     heuristic_setup: Duration,
     /// [`Self::target_ok`] of non-neutral footprints by (cell, orientation, offsets): a
     /// footprint is entered from several predecessors, and each check runs the standing
     /// rule's IK.
     standable: HashMap<(i16, i16, u8, FootOffsets), bool, FxBuild>,
+}
+
+/// The parts of the hybrid heuristic of a state (`HybridGraph::heuristic_parts`):
+/// `h = max(driving, to_go) + steps + behind − ahead`, clamped at zero, or infinite
+/// when `reachable` is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HeuristicParts {
+    /// Infinite when the base cell cannot reach the goal at all (`reachability`).
+    pub reachable: Cost,
+    /// Euclidean distance plus turn (`driving`).
+    pub driving: Cost,
+    /// The base-cell cost-to-go (`cost_to_go`).
+    pub to_go: Cost,
+    /// The step bound Σ_k S_k (`heuristic`).
+    pub steps: Cost,
+    /// Φ's part for feet behind neutral, c · Σ o⁻.
+    pub behind: Cost,
+    /// Φ's part for feet ahead of neutral, c · Σ o⁺ (subtracted).
+    pub ahead: Cost,
 }
 
 /// A lattice state by what it means, not by this graph's footprint ids: cell,
@@ -387,6 +410,13 @@ impl<'c> HybridGraph<'c> {
         let near = near_obstacle_layer(maps, config.step_obstacle_distance_m);
         let t0 = Instant::now();
         let step_bound = build_step_bound(maps, &near, &config, &lattice, goal);
+        // A base shift costs at least f · k10 per metre (C_B ≥ 1) and raises the
+        // foot-offset potential by 4 c per cell (`heuristic::offset_potential`).
+        let shift_step =
+            Cost::from_f64_floor(config.step_cost_factor * config.k10 * res * (1.0 - 1e-9))
+                .saturating_add(Cost(step_bound.offset_per_cell().0.saturating_mul(4)));
+        let cost_to_go =
+            CostToGo::new(lattice, &config.driving, shift_step, (goal.i, goal.j, goal.theta));
         let regions = BaseRegions::build(
             maps,
             robot,
@@ -425,6 +455,7 @@ impl<'c> HybridGraph<'c> {
             special: Vec::with_capacity(16),
             stats: ManoeuvreStats::default(),
             step_bound,
+            cost_to_go,
             heuristic_setup,
             standable: HashMap::default(),
         })
@@ -434,6 +465,38 @@ impl<'c> HybridGraph<'c> {
     /// of any search's time).
     pub fn heuristic_setup_time(&self) -> Duration {
         self.heuristic_setup
+    }
+
+    /// The parts of the heuristic of `s` (see [`HeuristicParts`]).
+    pub fn heuristic_parts(&self, s: LatticeState) -> HeuristicParts {
+        let mut p = HeuristicParts {
+            reachable: Cost::ZERO,
+            driving: Cost::ZERO,
+            to_go: Cost::ZERO,
+            steps: Cost::ZERO,
+            behind: Cost::ZERO,
+            ahead: Cost::ZERO,
+        };
+        if !self.regions.reachable(s.i, s.j) {
+            p.reachable = Cost::INFINITY;
+            return p;
+        }
+        p.driving = self.driving.heuristic(s);
+        p.to_go = self.cost_to_go.get(self.maps, s.i, s.j, s.theta);
+        if !self.cost_to_go.oriented() {
+            // One layer for all orientations: turns are not in it.
+            p.to_go = p.to_go.saturating_add(self.driving.turn_heuristic(s));
+        }
+        if let Some(o) = self.footprints.get(s.footprint) {
+            p.steps = self.step_bound.lower_bound(self.maps, &self.feet_pos(s, &o));
+            (p.behind, p.ahead) = self.step_bound.offset_potential(&o);
+        }
+        p
+    }
+
+    /// Base cells the heuristic's cost-to-go has settled so far.
+    pub fn cost_to_go_cells(&self) -> usize {
+        self.cost_to_go.settled()
     }
 
     /// Number of foot components the step bound found (0: no step bound).
@@ -1182,20 +1245,22 @@ impl SearchGraph for HybridGraph<'_> {
         }
     }
 
-    /// The driving heuristic (Euclidean distance plus turn, [`DrivingGraph`]) plus the
-    /// step bound Σ_k S_k of the four feet (`heuristic` module): consistent on every
-    /// manoeuvre (see the module docs of both).
+    /// The larger of the driving heuristic (Euclidean distance plus turn,
+    /// [`DrivingGraph`]) and the base-cell cost-to-go (`cost_to_go`), plus the step
+    /// bound Σ_k S_k of the four feet and the foot-offset potential Φ (`heuristic`
+    /// module), clamped at zero: consistent on every manoeuvre (see the module docs of
+    /// all three and of this module).
     fn heuristic(&self, s: LatticeState) -> Cost {
-        if !self.regions.reachable(s.i, s.j) {
+        let p = self.heuristic_parts(s);
+        if p.reachable.is_infinite() {
             return Cost::INFINITY;
         }
-        let h = self.driving.heuristic(s);
-        let Some(o) = self.footprints.get(s.footprint) else {
+        let h = p.driving.max(p.to_go).saturating_add(p.steps).saturating_add(p.behind);
+        if h.is_infinite() {
             return h;
-        };
-        let feet = self.feet_pos(s, &o);
-        h.saturating_add(self.step_bound.lower_bound(self.maps, &feet))
-            .saturating_add(self.step_bound.offset_potential(&o))
+        }
+        // Clamped at zero (feet ahead of neutral have paid in advance).
+        h.saturating_sub(p.ahead)
     }
 
     fn is_goal(&self, s: LatticeState) -> bool {
