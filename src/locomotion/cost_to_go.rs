@@ -1,66 +1,72 @@
-//! The base-cell cost-to-go: the hybrid heuristic's informed lower bound on the driving
-//! and base-shift costs still to come ([`super::HybridGraph`], issue 15). A backward
-//! Dijkstra from the goal cell over the x-y cells of the lattice, where every edge costs
-//! at most what any manoeuvre of the hybrid graph that moves the base between those
-//! cells costs, minimised over orientations and footprints: an exact relaxation, so the
-//! distance `D(c)` it computes is consistent on every edge of the hybrid graph.
+//! The base-pose cost-to-go: the hybrid heuristic's informed lower bound on the driving,
+//! turning and base-shift costs still to come ([`super::HybridGraph`], issue 15). A
+//! backward Dijkstra from the goal over (cell, orientation) nodes of the lattice — the
+//! nodes `reachability` floods, with costs — in which every edge weighs at most what the
+//! manoeuvre of the hybrid graph it stands for costs, whatever the footprint: an exact
+//! relaxation, so the distance `D` it computes is consistent on every edge of the hybrid
+//! graph. `HybridGraph::heuristic` takes `max(Euclidean + turn, D)` and adds the step
+//! bound and the foot-offset potential of `heuristic`.
 //!
 //! **Which edges move the base.** Of the hybrid graph's manoeuvres (`hybrid` module
-//! docs) only drives and base shifts change the base cell. Turns on the spot, abstract
-//! steps, "front foot forward" and "foot to neutral" leave the base on its cell, so `D`
-//! is the same at both ends of those edges and `D(s) ≤ c(s, t) + D(t)` holds with any
-//! cost `c ≥ 0`. (Their costs are what other parts of the heuristic bound: the turn term
-//! of the driving heuristic, the step bound and the foot-offset potential of
-//! `heuristic`.)
+//! docs) drives, turns on the spot and base shifts change the base pose. Abstract steps,
+//! "front foot forward" and "foot to neutral" leave it where it is, so `D` is the same at
+//! both ends of those edges and `D(s) ≤ c(s, t) + D(t)` holds for any cost `c ≥ 0`
+//! (their costs are what the step bound and the foot-offset potential bound).
 //!
-//! **Drive edges.** A drive by move `m` (16- or 20-neighbourhood) from cell a to cell b
-//! at any orientation θ costs `L_m · k_Δθ · (C(a, θ) + C(b, θ)) / 2` (`driving` module
-//! docs; rounded up to the micro-unit), with `C` the driving pose cost (eq. 4) of the
-//! neutral footprint raised to 1, and `k_Δθ ≥ 1` (Fig. 8). The driving graph also drops
-//! poses its feasibility model rejects, which only removes edges. So with
-//! `P(c) = min_θ max(1, C(c, θ))` over *every* orientation (∞ if no orientation has a
-//! finite pose cost) the relaxed edge `a → b` weighs `L_m · (P(a) + P(b)) / 2`. `P` is
-//! computed with the very poses (`Lattice::pose`) and the very cost function
-//! (`CostMaps::driving_pose_cost`) the driving graph uses, less a relative 10⁻⁶ for the
-//! driving graph's `f32` cache of pose costs (relative error ≤ 6·10⁻⁸).
+//! **Drive and turn edges** (`driving` module docs, eq. 4, Fig. 8). A drive by move `m`
+//! from (a, θ) to (b, θ) costs `L_m · k_Δθ · (C(a, θ) + C(b, θ)) / 2` and a turn from
+//! (a, θ) to (a, θ ± 1) costs `r_turn · 2π/n · (C(a, θ) + C(a, θ ± 1)) / 2`, both rounded
+//! up to the micro-unit, with `C` the driving pose cost of the neutral footprint raised
+//! to 1. The driving graph also drops poses its feasibility model rejects, which only
+//! removes edges. So the relaxed edges take the same formulas with `P(a, θ)` =
+//! `max(1, C(a, θ))` computed with the very poses (`Lattice::pose`), cost function
+//! (`CostMaps::driving_pose_cost`) and move weights `L_m · k_Δθ` the driving graph uses,
+//! less a relative 10⁻⁶ for the driving graph's `f32` cache of pose costs (relative error
+//! ≤ 6·10⁻⁸); `P = ∞` (no edge) where `C` is not finite.
 //!
-//! **Base-shift edges.** A base shift by `l` cells along the heading moves the base from
-//! the centre of cell a to `a + l · res · (cos θ, sin θ)` and snaps it to the cell b
-//! holding that point (`hybrid` module docs). Along each axis the cell index changes by
-//! `⌊1/2 + l · cos θ⌋` (likewise sin), at most `l` in magnitude: the Chebyshev distance
-//! `‖b − a‖∞ ≤ l`. Its cost is `max(f · k10 · l · res · C_B,avg, moved) ≥ f · k10 · l · res`
-//! (C_B ≥ 1, eq. 3; f the step-related factor), and it lowers all four foot offsets by
-//! l, which raises the foot-offset potential Φ of the heuristic by at least
-//! `4 c · l · res` (`heuristic::offset_potential`: a foot behind neutral falls further
-//! behind, one ahead has used up its lead). The relaxation links every cell to its eight
-//! neighbours with weight `β · res`, `β = f · k10 + 4 c`: a chain of `‖b − a‖∞ ≤ l` such
-//! links joins a to b for at most `β · l · res`, and `D` drops by no more than the
-//! shift's cost plus Φ's rise. The links are not restricted to cells where the robot can
-//! stand, which only weakens the bound (a wall is crossed at `β` per cell instead of
-//! walked around): every cell is connected, and `D` is finite on the whole map.
+//! **Base-shift edges.** A base shift by `l` cells along the heading θ moves the base
+//! from the centre of cell a to `a + l · res · (cos θ, sin θ)` and snaps it to the cell b
+//! holding that point (`hybrid` module docs). The cell of the exact position after k
+//! cell-lengths is `⌊1/2 + k · cos θ⌋` cells from a along x (likewise y), so from one k
+//! to the next each axis steps by 0 or by the sign of its direction cosine: a chain of at
+//! most l *forward links* of layer θ (the up to three steps into the heading's quadrant)
+//! joins (a, θ) to (b, θ). The shift costs `max(f · k10 · l · res · C_B,avg, moved) ≥
+//! f · k10 · l · res` (C_B ≥ 1, eq. 3; f the step-related factor), and it lowers all four
+//! foot offsets by l, which raises the foot-offset potential Φ of the heuristic by at
+//! least `4 c · l · res` (`heuristic::offset_potential`). A link weighs
+//! `β · res = f · k10 · res + 4 c · res`, so `D` drops along the chain by no more than
+//! the shift's cost plus Φ's rise. The links are not restricted to cells where the robot
+//! can stand, which only weakens the bound. (Float noise could snap the end to another
+//! cell only where `1/2 + k cos θ` is within about 10⁻¹² of an integer; with 64
+//! orientations it stays at least 4·10⁻⁴ away for every k ≤ 127.)
 //!
-//! **Consistency** (and admissibility: `D(goal) = 0`). For every drive s → t the relaxed
-//! graph has a path from cell(s) to cell(t) no heavier than the edge's cost, for every
-//! base shift one no heavier than its cost plus Φ's rise, and edges that keep the base
-//! cell need none; so Dijkstra's `D(cell(s)) ≤ w(path) + D(cell(t))` gives
-//! `D(s) + Φ(s) ≤ c(s, t) + D(t) + Φ(t)` on every edge that moves the base (Φ is zero
-//! on drives). The other edges are the business of the other parts of the heuristic. In fixed point: relaxed
-//! weights are rounded down (with a relative slack of 10⁻⁹), edges up, and `D` sums
-//! integers, so the inequality holds exactly.
+//! **Consistency** (and admissibility: `D = 0` at the goal, where the search starts).
+//! For every drive or turn s → t the relaxed graph has an edge from s's node to t's no
+//! heavier than the edge, for every base shift a path no heavier than its cost plus Φ's
+//! rise, and edges that keep the base pose need none; so Dijkstra's
+//! `D(s) ≤ w(path) + D(t)` gives `D(s) + Φ(s) ≤ c(s, t) + D(t) + Φ(t)` on every edge
+//! that moves the base (Φ is zero on drives and turns: neutral footprint). In fixed
+//! point: relaxed weights are rounded down (with a relative slack of 10⁻⁹), edges up,
+//! and `D` sums integers, so the inequalities hold exactly.
+//!
+//! **One layer for large maps.** Above [`MAX_ORIENTED_NODES`] (cell, orientation) nodes
+//! the search has one node per cell instead: `P` is the minimum over orientations,
+//! `k_Δθ` is taken as its least value 1, base shifts link all eight neighbours, and
+//! there are no turn edges (the hybrid graph adds the driving heuristic's turn term,
+//! consistent on its own, instead). Every argument above holds for the minimum.
 //!
 //! **Laziness.** Like the obstacle heuristic of Nav2's Smac planner, the Dijkstra runs
-//! only as far as the queries need: a query for an unsettled cell resumes the queue
-//! until that cell is settled, and `P` is computed per cell when the search first
+//! only as far as the queries need: a query for an unsettled node resumes the queue
+//! until that node is settled, and `P` is computed per node when the search first
 //! touches it. The graph (and with it this search) lives for one plan, so every ARA*
-//! iteration reuses what earlier ones settled.
+//! iteration reuses what earlier ones settled. The queue is a bucket queue (Dial's
+//! algorithm; buckets no wider than the lightest edge), exact like a binary heap.
 
 use super::driving::DrivingConfig;
 use super::lattice::{Lattice, LatticeState};
 use crate::cost::CostMaps;
 use crate::planner::Cost;
 use std::cell::RefCell;
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 /// Relative slack on `P` for the driving graph's `f32` pose-cost cache.
 const POSE_SLACK: f64 = 1e-6;
@@ -87,6 +93,8 @@ pub struct CostToGo {
     shift_links: Vec<Vec<(i32, i32)>>,
     /// Weight of one link of a base shift, `β · res` rounded down.
     shift_step: Cost,
+    /// `(sin, cos)` of each orientation's yaw, as `Pose2::theta.sin_cos()` gives them.
+    trig: Vec<(f64, f64)>,
     search: RefCell<Search>,
 }
 
@@ -100,7 +108,7 @@ struct Search {
     /// Tentative distances; final once `done`.
     dist: Vec<Cost>,
     done: Vec<bool>,
-    queue: BinaryHeap<Reverse<(Cost, u32)>>,
+    queue: Buckets,
     /// Nodes settled so far.
     settled: usize,
 }
@@ -138,12 +146,15 @@ impl CostToGo {
             }
             shift_links.push(if layers > 1 { forward_links(heading) } else { all_links() });
         }
+        let turn_length =
+            if layers > 1 { driving.turn_radius_m * lattice.orientation_step() } else { 0.0 };
+        let shift_step = shift_step.max(Cost(1));
         let n = cells * layers;
         let mut search = Search {
             pose: vec![0.0; n],
             dist: vec![Cost::INFINITY; n],
             done: vec![false; n],
-            queue: BinaryHeap::new(),
+            queue: Buckets::new(min_weight(&lattice, &move_weight, turn_length, shift_step)),
             settled: 0,
         };
         let (gi, gj, gt) = goal;
@@ -156,7 +167,7 @@ impl CostToGo {
             for t in sources {
                 let node = g * layers + t;
                 search.dist[node] = Cost::ZERO;
-                search.queue.push(Reverse((Cost::ZERO, node as u32)));
+                search.queue.push(Cost::ZERO, node as u32);
             }
         }
         Self {
@@ -164,13 +175,10 @@ impl CostToGo {
             layers,
             moves,
             move_weight,
-            turn_length: if layers > 1 {
-                driving.turn_radius_m * lattice.orientation_step()
-            } else {
-                0.0
-            },
+            turn_length,
             shift_links,
             shift_step,
+            trig: (0..lattice.orientations).map(|k| lattice.yaw(k as u8).sin_cos()).collect(),
             search: RefCell::new(search),
         }
     }
@@ -222,7 +230,8 @@ impl CostToGo {
         let mut best = f64::INFINITY;
         for theta in thetas {
             let pose = self.lattice.pose(LatticeState::new(i, j, theta as u8));
-            if let Some(cost) = maps.driving_pose_cost(&pose).finite() {
+            let sc = self.trig[usize::from(theta)];
+            if let Some(cost) = maps.driving_pose_cost_sc(&pose, sc).finite() {
                 best = best.min(cost.max(1.0));
             }
         }
@@ -239,11 +248,13 @@ impl CostToGo {
         let (nx, ny) = (i32::from(self.lattice.nx), i32::from(self.lattice.ny));
         let layers = self.layers;
         let node_of = |a: i32, b: i32, t: usize| (b * nx + a) as usize * layers + t;
-        while let Some(Reverse((d, c))) = search.queue.pop() {
+        while let Some(c) = search.queue.pop() {
             let c = c as usize;
-            if search.done[c] || d > search.dist[c] {
+            // Stale entries (the node was settled, or queued again lower): skip.
+            if search.done[c] || !search.queue.holds(search.dist[c]) {
                 continue;
             }
+            let d = search.dist[c];
             search.done[c] = true;
             search.settled += 1;
             let (cell, t) = (c / layers, c % layers);
@@ -302,7 +313,7 @@ impl CostToGo {
     fn relax(search: &mut Search, n: usize, d: Cost) {
         if !search.done[n] && d < search.dist[n] {
             search.dist[n] = d;
-            search.queue.push(Reverse((d, n as u32)));
+            search.queue.push(d, n as u32);
         }
     }
 }
@@ -344,4 +355,68 @@ fn forward_links(heading: f64) -> Vec<(i32, i32)> {
         }
     }
     v
+}
+
+/// The smallest edge weight of the relaxed graph, at least one micro-unit: pose costs
+/// are at least 1 (less the slacks), so a drive weighs at least its `L · k_Δθ` and a turn
+/// its wheel travel.
+fn min_weight(lattice: &Lattice, move_weight: &[f64], turn_length: f64, shift_step: Cost) -> Cost {
+    let drive = move_weight.iter().copied().fold(f64::INFINITY, f64::min);
+    let turn = if turn_length > 0.0 { turn_length } else { f64::INFINITY };
+    let w = Cost::from_f64_floor(drive.min(turn).min(lattice.resolution) * (1.0 - 1e-3));
+    w.min(shift_step).max(Cost(1))
+}
+
+/// Dial's bucket queue: bucket k holds the nodes queued with a distance in
+/// `[k · width, (k + 1) · width)`. With `width` at most the smallest edge weight, a node
+/// relaxed from bucket k lands in a later bucket, so every node of the current bucket is
+/// final when it is taken, in any order: the distances are exactly Dijkstra's (and the
+/// same on every run). Cheaper than a binary heap of millions of entries.
+#[derive(Debug)]
+struct Buckets {
+    width: u64,
+    /// Indexed by absolute bucket number; emptied buckets keep their allocation.
+    buckets: Vec<Vec<u32>>,
+    /// The bucket being taken from.
+    current: usize,
+    len: usize,
+}
+
+impl Buckets {
+    fn new(width: Cost) -> Self {
+        Self { width: width.0.max(1), buckets: Vec::new(), current: 0, len: 0 }
+    }
+
+    fn bucket(&self, d: Cost) -> usize {
+        usize::try_from(d.0 / self.width).unwrap_or(usize::MAX)
+    }
+
+    fn push(&mut self, d: Cost, node: u32) {
+        let b = self.bucket(d);
+        if b == usize::MAX {
+            return;
+        }
+        if b >= self.buckets.len() {
+            self.buckets.resize_with(b + 1, Vec::new);
+        }
+        self.buckets[b].push(node);
+        self.len += 1;
+    }
+
+    /// Whether a node queued at distance `d` belongs to the bucket being taken (else
+    /// its entry is stale).
+    fn holds(&self, d: Cost) -> bool {
+        self.bucket(d) == self.current
+    }
+
+    fn pop(&mut self) -> Option<u32> {
+        while self.len > 0 {
+            if let Some(n) = self.buckets.get_mut(self.current).and_then(Vec::pop) {
+                self.len -= 1;
+                return Some(n);
+            }
+            self.current += 1;
+        }
+        None
+    }
 }

@@ -53,10 +53,6 @@
 //! Of the k7 term only the share `1 − λ` enters `w`: the share λ pays for the
 //! foot-offset potential of the hybrid heuristic ([`offset_potential`]).
 //!
-//! (The per-cell rolling cost of driving and base shifts is bounded by the base-cell
-//! cost-to-go of the `cost_to_go` module, which the hybrid heuristic combines with this
-//! bound; the paragraph below explains why it is not a per-foot bound.)
-//!
 //! The component graph with these edge weights `w(A, B)` (B = A included) is searched
 //! backwards from the component of each goal foot (Dijkstra, dense, O(K²) for K
 //! components): `S_k(A)` is the cheapest chain of steps from A to foot k's goal
@@ -66,9 +62,10 @@
 //! (Dijkstra) `≤ c + S_k(B)`, and the other feet's terms do not change. Every other
 //! manoeuvre leaves all four components, hence the bound, unchanged. So `Σ_k S_k` is
 //! consistent on its own with respect to the step edges and invariant on all others; it
-//! is zero at the goal. Added to the driving heuristic (Euclidean distance plus turn,
-//! consistent with respect to drives, turns and base shifts and unchanged by steps and
-//! foot moves), the sum is consistent for every edge of the hybrid graph. Weights are
+//! is zero at the goal. Added to the driving part of the heuristic (the larger of the
+//! Euclidean distance plus turn and the cost-to-go of `cost_to_go`, consistent with
+//! respect to drives, turns and base shifts and unchanged by steps and foot moves), the
+//! sum is consistent for every edge of the hybrid graph. Weights are
 //! rounded down to the micro-unit with a relative slack of 10⁻⁹ (edges round up), and
 //! the Dijkstra sums integers, so the bound holds exactly in fixed point.
 //!
@@ -84,8 +81,11 @@
 //! half a cell diagonal, repeatedly, for as little as `f · k10 · res` (one cell, C_B = 1).
 //! Consistency then caps the rolling weight at C_F ≈ 5, and base shifts are possible
 //! wherever a foot can come close to any obstacle (walls included), i.e. almost
-//! everywhere. The same cap (≈ 3.7 per metre) limits a per-cell bound on base motion
-//! taken from the driving pose costs. Neither is worth its set-up time.
+//! everywhere. The driving cost is bounded per base pose instead, by the cost-to-go of
+//! `cost_to_go` (drives at their real pose costs; base shifts at `f · k10` per cell plus
+//! the rise of the foot-offset potential, `f · (k10 + 4 k11 · C_F,min)` ≈ 10.75 per
+//! metre with the paper's constants: what a crawl of base shifts and foot moves costs at
+//! the least).
 
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::planner::Cost;

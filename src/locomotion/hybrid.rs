@@ -61,27 +61,34 @@
 //!   same issue). The edge cost is `max(C_BS · factor, distance moved)`, which keeps the
 //!   heuristic consistent even for factors below 2.
 //!
-//! **Heuristic** (issue 4), a sum of three parts, each consistent on every manoeuvre:
+//! **Heuristic** (issues 4 and 15): `max(h_E, D) + S + Φ`, clamped at zero, where
 //!
-//! 1. that of [`DrivingGraph`]: Euclidean distance plus the orientation difference times
-//!    the turning radius. Steps and foot moves leave the base in place; drives and base
-//!    shifts cost at least the distance they move the base (pose costs ≥ 1, k_Δθ ≥ 1,
-//!    and a base shift's cost is at least its move); turns cost at least their arc;
-//! 2. the step bound Σ_k S_k of the `heuristic` module: per foot, the cheapest chain of
-//!    steps (C_S, eq. 5, times the step-related factor) from the foot's component of
-//!    finite-C_F cells to the component of its goal position. Only a step moves a foot
-//!    between components, and it costs at least the bound's drop;
-//! 3. the foot-offset potential c · Σ_k |o_k| (offsets in metres; zero for the neutral
-//!    footprint): every offset must be undone before the neutral goal, and each
-//!    manoeuvre that changes offsets pays c per metre — foot moves by eq. 6 (C_F ≥ the
-//!    map's smallest), base shifts by C_BS ≥ f · k10 · L (C_B ≥ 1, eq. 3) with room
-//!    left for part 1, steps by the share λ of eq. 5's k7 term that part 2 leaves out
-//!    (`heuristic::offset_potential`).
+//! 1. `h_E` is that of [`DrivingGraph`]: Euclidean distance plus the orientation
+//!    difference times the turning radius. Steps and foot moves leave the base in place;
+//!    drives and base shifts cost at least the distance they move the base (pose costs
+//!    ≥ 1, k_Δθ ≥ 1, and a base shift's cost is at least its move); turns cost at least
+//!    their arc;
+//! 2. `D` is the cost-to-go of the `cost_to_go` module: a lazy backward Dijkstra over
+//!    (cell, orientation) whose edges relax drives (the pose cost of eq. 4 at that
+//!    orientation, k_Δθ), turns and base shifts (f · k10 per cell, plus Φ's rise);
+//!    consistent on every manoeuvre, with Φ on base shifts. The larger of two consistent
+//!    heuristics is consistent, and both parts leave the same share of each edge's cost
+//!    to the parts below (none of drives and turns, Φ's rise on base shifts, all of
+//!    steps and foot moves);
+//! 3. `S` is the step bound Σ_k S_k of the `heuristic` module: per foot, the cheapest
+//!    chain of steps (C_S, eq. 5, times the step-related factor) from the foot's
+//!    component of finite-C_F cells to the component of its goal position. Only a step
+//!    moves a foot between components, and it costs at least the bound's drop;
+//! 4. `Φ = c · Σ_k (o_k⁻ − o_k⁺)` is the foot-offset potential (offsets in metres; zero
+//!    for the neutral footprint): a foot behind neutral still has to come forward, one
+//!    ahead has paid in advance for base motion `D` counts. Foot moves pay c per metre by
+//!    eq. 6 (C_F ≥ the map's smallest), steps by the share λ of eq. 5's k7 term that `S`
+//!    leaves out; a base shift raises Φ (`heuristic::offset_potential`).
 //!
-//! Part 2 is zero where no step is needed and part 3 for the neutral footprint, so a
-//! driving state on flat ground gets part 1 alone, as before. The
-//! proofs are in the `heuristic` module docs; `locomotion::tests` checks
-//! `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge.
+//! `S` is zero where no step is needed and Φ for the neutral footprint. The proofs are
+//! in the `cost_to_go` and `heuristic` module docs; `locomotion::tests` checks
+//! `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge and
+//! on random walks over random small maps, and that A*'s optimum does not change.
 
 use super::cost_to_go::CostToGo;
 use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, edge_cost};
