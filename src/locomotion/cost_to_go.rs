@@ -50,7 +50,7 @@
 //! and `D` sums integers, so the inequalities hold exactly.
 //!
 //! **One layer for large maps.** Above [`MAX_ORIENTED_NODES`] (cell, orientation) nodes
-//! the search has one node per cell instead: `P` is the minimum over orientations,
+//! (`HybridConfig::max_oriented_nodes`) the search has one node per cell instead: `P` is the minimum over orientations,
 //! `k_Δθ` is taken as its least value 1, base shifts link all eight neighbours, and
 //! there are no turn edges (the hybrid graph adds the driving heuristic's turn term,
 //! consistent on its own, instead). Every argument above holds for the minimum.
@@ -72,9 +72,10 @@ use std::cell::RefCell;
 const POSE_SLACK: f64 = 1e-6;
 /// Relative slack on relaxed edge weights (edges are rounded up with 10⁻¹²).
 const WEIGHT_SLACK: f64 = 1e-9;
-/// Most (cell, orientation) nodes searched with one layer per orientation; larger maps
-/// get one layer (the minimum over orientations), at a quarter of the memory per cell.
-pub const MAX_ORIENTED_NODES: usize = 1 << 24;
+/// Default for the most (cell, orientation) nodes searched with one layer per
+/// orientation (13 bytes each: about 110 MB at the limit, a 9 m × 9 m map with 64
+/// orientations); larger maps get one layer, the minimum over orientations.
+pub const MAX_ORIENTED_NODES: usize = 1 << 23;
 
 /// The lazily computed backward Dijkstra over base cells (see the module docs).
 #[derive(Debug)]
@@ -116,18 +117,20 @@ struct Search {
 impl CostToGo {
     /// The cost-to-go on `lattice` toward `goal` (cell, and orientation if it is fixed),
     /// with the driving moves, k_Δθ and turn length of `driving` and `shift_step`, the
-    /// weight β · res of one link of a base shift (see the module docs). Nothing is
-    /// computed until the first query.
+    /// weight β · res of one link of a base shift (see the module docs); one layer per
+    /// orientation if that makes at most `max_oriented_nodes` nodes, else one. Nothing
+    /// is computed until the first query.
     pub fn new(
         lattice: Lattice,
         driving: &DrivingConfig,
         shift_step: Cost,
         goal: (i16, i16, Option<u8>),
+        max_oriented_nodes: usize,
     ) -> Self {
         let cells = usize::from(lattice.nx) * usize::from(lattice.ny);
         let orientations = usize::from(lattice.orientations).max(1);
         let layers =
-            if cells.saturating_mul(orientations) <= MAX_ORIENTED_NODES { orientations } else { 1 };
+            if cells.saturating_mul(orientations) <= max_oriented_nodes { orientations } else { 1 };
         let res = lattice.resolution;
         let all = driving.neighbourhood.moves();
         let moves = all.iter().map(|m| (i32::from(m.di), i32::from(m.dj))).collect();

@@ -215,6 +215,9 @@ pub struct HybridConfig {
     pub foot_move_increment_m: f64,
     /// Cap on distinct footprints (graph size guard).
     pub max_footprints: usize,
+    /// Most (cell, orientation) nodes for which the heuristic's cost-to-go keeps one
+    /// layer per orientation (`cost_to_go::MAX_ORIENTED_NODES`); above, one layer.
+    pub max_oriented_nodes: usize,
     /// Driving leg height (Sec. VI-B), m: the driving posture the feasibility model checks.
     pub driving_leg_height_m: f64,
     /// Smallest stability margin of a posture, m (the generator's requirement).
@@ -244,6 +247,7 @@ impl HybridConfig {
             step_support_margin_m: params.step_support_margin_m,
             foot_move_increment_m: 0.1,
             max_footprints: 65_536,
+            max_oriented_nodes: super::cost_to_go::MAX_ORIENTED_NODES,
             driving_leg_height_m: params.driving_leg_height_m,
             min_stability_margin_m: params.min_stability_margin_m,
             base_circle_radius_m: params.base_circle_radius_m,
@@ -422,8 +426,13 @@ impl<'c> HybridGraph<'c> {
         let shift_step =
             Cost::from_f64_floor(config.step_cost_factor * config.k10 * res * (1.0 - 1e-9))
                 .saturating_add(Cost(step_bound.offset_per_cell().0.saturating_mul(4)));
-        let cost_to_go =
-            CostToGo::new(lattice, &config.driving, shift_step, (goal.i, goal.j, goal.theta));
+        let cost_to_go = CostToGo::new(
+            lattice,
+            &config.driving,
+            shift_step,
+            (goal.i, goal.j, goal.theta),
+            config.max_oriented_nodes,
+        );
         let regions = BaseRegions::build(
             maps,
             robot,

@@ -662,7 +662,8 @@ mod hybrid {
 
         /// Random edges of random small maps: from a random state (any orientation,
         /// neutral or a random footprint), a random walk of four edges, checking
-        /// `h(s) ≤ c(s, t) + h(t)` on every successor on the way.
+        /// `h(s) ≤ c(s, t) + h(t)` on every successor on the way; with the cost-to-go
+        /// per orientation or in one layer, the goal's orientation fixed or free.
         #[test]
         fn heuristic_is_consistent_on_random_maps(
             boxes in proptest::collection::vec(random_box(), 1..=3),
@@ -670,10 +671,21 @@ mod hybrid {
             o in proptest::array::uniform4(-12i8..=16),
             neutral in proptest::prelude::any::<bool>(),
             walk in proptest::collection::vec(0usize..1000, 4),
+            one_layer in proptest::prelude::any::<bool>(),
+            free_goal_theta in proptest::prelude::any::<bool>(),
         ) {
             let maps = random_maps(&boxes);
             let goal = state_at(&graph(&maps, LatticeState::new(0, 0, 0)), 2.0, 0.0);
-            let mut g = graph(&maps, goal);
+            // Both forms of the cost-to-go: per orientation, and one layer for all.
+            let cfg = HybridConfig {
+                max_oriented_nodes: if one_layer { 0 } else { usize::MAX },
+                ..config()
+            };
+            let target = DrivingGoal {
+                theta: if free_goal_theta { None } else { Some(goal.theta) },
+                ..DrivingGoal::at(goal)
+            };
+            let mut g = HybridGraph::new(&maps, &robot(), 64, cfg, target).expect("graph");
             let s = g.lattice().state(&Pose2::new(x, y, 0.0)).expect("on the map");
             let s = LatticeState { theta, ..s };
             let mut s = if neutral { s } else { g.with_offsets(s, o).expect("interned") };
@@ -746,101 +758,5 @@ mod hybrid {
             assert!(s.cost.to_f64() <= s.epsilon * best.cost.to_f64() + 1e-6);
         }
         assert_eq!(r.best().map(|s| s.cost), Some(best.cost));
-    }
-
-    #[test]
-    #[ignore = "diagnostic"]
-    fn diag_heuristic_along_the_optimal_path() {
-        let prims =
-            [Primitive::Box { center: [1.8, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 }];
-        let m = rasterise(&prims, [-0.8, -0.8], [3.2, 1.6], 0.025).expect("map");
-        let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("maps");
-        let g = graph(&maps, LatticeState::new(0, 0, 0));
-        let start = state_at(&g, 0.0, 0.0);
-        let goal = state_at(&g, 1.5, 0.0);
-        let cfg = config();
-        let mut g = HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("g");
-        let a = astar(&mut g, start, &SearchParams::default());
-        let best = a.best().expect("a path up");
-        let total = best.cost.to_f64();
-        let mut acc = 0.0;
-        for w in best.path.windows(2) {
-            let (c, m) = g.edge(w[0], w[1]).expect("edge");
-            let s = w[0];
-            eprintln!(
-                "{:?} x={:.3} togo={:.3} h={:.3} {:?} c={:.3}",
-                (s.i, s.j, s.theta),
-                g.pose(s).x,
-                total - acc,
-                g.heuristic(s).to_f64(),
-                m.kind,
-                c.to_f64()
-            );
-            acc += c.to_f64();
-        }
-        eprintln!("expansions {}", a.expansions);
-    }
-
-    struct Counting<'a, 'c> {
-        g: &'a mut HybridGraph<'c>,
-        seen: Vec<LatticeState>,
-    }
-
-    impl SearchGraph for Counting<'_, '_> {
-        type State = LatticeState;
-        fn successors(&mut self, s: LatticeState, out: &mut Vec<(LatticeState, Cost)>) {
-            self.seen.push(s);
-            self.g.successors(s, out)
-        }
-        fn heuristic(&self, s: LatticeState) -> Cost {
-            self.g.heuristic(s)
-        }
-        fn is_goal(&self, s: LatticeState) -> bool {
-            self.g.is_goal(s)
-        }
-        fn dense_len(&self) -> usize {
-            self.g.dense_len()
-        }
-        fn dense_index(&self, s: LatticeState) -> Option<usize> {
-            self.g.dense_index(s)
-        }
-    }
-
-    #[test]
-    #[ignore = "diagnostic"]
-    fn diag_platform_expansions() {
-        let name = std::env::var("DIAG_SCENARIO").unwrap_or("platform".into());
-        let path = format!("{}/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-        let sc = crate::scenario::Scenario::load(std::path::Path::new(&path)).expect("load");
-        let p = crate::jobs::plan::prepare(&sc, &robot(), None, None).expect("prep");
-        let mut g = p.graph(&robot(), Neighbourhood::N20, 2.0).expect("graph");
-        let start = p.start;
-        let params = SearchParams { final_epsilon: 3.0, ..SearchParams::default() };
-        eprintln!("h(start) = {}", g.heuristic(start).to_f64());
-        let mut c = Counting { g: &mut g, seen: Vec::new() };
-        let r = arastar(&mut c, start, &params).expect("ok");
-        let seen = std::mem::take(&mut c.seen);
-        let best = r.best().expect("sol");
-        eprintln!("cost {} expansions {}", best.cost.to_f64(), r.expansions);
-        let neutral = seen.iter().filter(|s| s.footprint == 0).count();
-        eprintln!("neutral {neutral} non-neutral {}", seen.len() - neutral);
-        let mut cells: Vec<_> = seen.iter().map(|s| (s.i, s.j)).collect();
-        cells.sort();
-        cells.dedup();
-        eprintln!("distinct cells {}", cells.len());
-        let mut hist = std::collections::BTreeMap::new();
-        for s in &seen {
-            let x = (g.pose(*s).x * 4.0).floor() / 4.0;
-            let e = hist.entry((x * 100.0) as i64).or_insert((0, 0));
-            if s.footprint == 0 { e.0 += 1 } else { e.1 += 1 }
-        }
-        for (x, (a, b)) in hist {
-            eprintln!("x {:.2}: neutral {a} other {b}", x as f64 / 100.0);
-        }
-        let mut xs = Vec::new();
-        for s in &best.path {
-            xs.push(format!("{:.2}/{:.1}", g.pose(*s).x, g.heuristic(*s).to_f64()));
-        }
-        eprintln!("path {}", xs.join(" "));
     }
 }
