@@ -67,6 +67,7 @@ use super::lattice::{Lattice, LatticeState};
 use crate::cost::CostMaps;
 use crate::planner::Cost;
 use std::cell::RefCell;
+use std::time::Instant;
 
 /// Relative slack on `P` for the driving graph's `f32` pose-cost cache.
 const POSE_SLACK: f64 = 1e-6;
@@ -112,6 +113,10 @@ struct Search {
     queue: Buckets,
     /// Nodes settled so far.
     settled: usize,
+    /// When the search must stop growing (the plan's time limit).
+    deadline: Option<Instant>,
+    /// Set when the deadline passed: a lower bound on `D` of every unsettled node.
+    frozen: Option<Cost>,
 }
 
 impl CostToGo {
@@ -159,6 +164,8 @@ impl CostToGo {
             done: vec![false; n],
             queue: Buckets::new(min_weight(&lattice, &move_weight, turn_length, shift_step)),
             settled: 0,
+            deadline: None,
+            frozen: None,
         };
         let (gi, gj, gt) = goal;
         if lattice.contains(i32::from(gi), i32::from(gj)) {
@@ -197,10 +204,30 @@ impl CostToGo {
         let layer = if self.layers > 1 { usize::from(theta) % self.layers } else { 0 };
         let node = cell * self.layers + layer;
         let mut search = self.search.borrow_mut();
-        if !search.done[node] {
+        if !search.done[node] && search.frozen.is_none() {
             self.run_until(&mut search, maps, node);
         }
-        if search.done[node] { search.dist[node] } else { Cost::INFINITY }
+        if search.done[node] {
+            search.dist[node]
+        } else {
+            // Frozen: the frontier's bound; else the queue ran empty: no path at all.
+            search.frozen.unwrap_or(Cost::INFINITY)
+        }
+    }
+
+    /// Stops growing the search once `deadline` has passed (checked every 1024 settled
+    /// nodes), so a plan's time limit holds however far the first queries reach. From
+    /// then on an unsettled node gets the frontier's distance `L` instead of `D`: every
+    /// unsettled node has `D ≥ L`, so this is `min(D, L)`, consistent like `D` (the
+    /// minimum of a consistent heuristic and a constant is), and fixed from then on
+    /// (queries before settled their nodes, whose `D` never changes).
+    pub fn set_deadline(&self, deadline: Option<Instant>) {
+        self.search.borrow_mut().deadline = deadline;
+    }
+
+    /// Whether the deadline stopped the search (see [`CostToGo::set_deadline`]).
+    pub fn frozen(&self) -> bool {
+        self.search.borrow().frozen.is_some()
     }
 
     /// Whether the search has one layer per orientation (else: one for all).
@@ -260,6 +287,9 @@ impl CostToGo {
             let d = search.dist[c];
             search.done[c] = true;
             search.settled += 1;
+            if search.settled % 1024 == 0 && search.deadline.is_some_and(|t| Instant::now() >= t) {
+                search.frozen = Some(search.queue.floor());
+            }
             let (cell, t) = (c / layers, c % layers);
             let (ci, cj) = ((cell % nx as usize) as i32, (cell / nx as usize) as i32);
             // Base shifts into c: from c minus a link of its layer.
@@ -306,7 +336,7 @@ impl CostToGo {
                     }
                 }
             }
-            if c == target {
+            if c == target || search.frozen.is_some() {
                 return;
             }
         }
@@ -406,6 +436,12 @@ impl Buckets {
         self.len += 1;
     }
 
+    /// A lower bound on the distance of every node not yet taken: the current bucket's
+    /// lower edge.
+    fn floor(&self) -> Cost {
+        Cost((self.current as u64).saturating_mul(self.width))
+    }
+
     /// Whether a node queued at distance `d` belongs to the bucket being taken (else
     /// its entry is stale).
     fn holds(&self, d: Cost) -> bool {
@@ -421,5 +457,64 @@ impl Buckets {
             self.current += 1;
         }
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::locomotion::lattice::Neighbourhood;
+    use crate::params::Params;
+    use crate::robot::RobotDescription;
+    use crate::scenario::Primitive;
+    use crate::terrain::rasterise;
+
+    fn setup() -> (CostMaps, Lattice, DrivingConfig) {
+        let robot = RobotDescription::reference();
+        let prims = [
+            Primitive::Box { center: [1.8, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 },
+            Primitive::Box { center: [0.5, 0.5], size: [0.2, 0.2], height: 0.1, yaw_deg: 20.0 },
+        ];
+        let m = rasterise(&prims, [-0.8, -0.8], [3.2, 1.6], 0.025).expect("map");
+        let maps = CostMaps::build(&m, &robot, &Params::default()).expect("maps");
+        let lattice = Lattice::for_map(maps.heights(), 64).expect("lattice");
+        let driving =
+            DrivingConfig::new(&Params::default(), &robot.neutral_footprint(), Neighbourhood::N16);
+        (maps, lattice, driving)
+    }
+
+    const GOAL: (i16, i16, Option<u8>) = (100, 32, Some(0));
+
+    #[test]
+    fn one_layer_is_below_every_orientation() {
+        let (maps, lattice, driving) = setup();
+        let step = Cost::from_f64_floor(0.3);
+        let oriented = CostToGo::new(lattice, &driving, step, GOAL, usize::MAX);
+        let flat = CostToGo::new(lattice, &driving, step, GOAL, 0);
+        assert!(oriented.oriented() && !flat.oriented());
+        for (i, j) in [(10, 32), (40, 20), (60, 50), (99, 32), (120, 10)] {
+            let one = flat.get(&maps, i, j, 0);
+            let best = (0..64).map(|t| oriented.get(&maps, i, j, t)).min().expect("64");
+            assert!(one <= best, "({i}, {j}): {one} > {best}");
+        }
+        assert_eq!(oriented.get(&maps, GOAL.0, GOAL.1, 0), Cost::ZERO);
+        assert_eq!(flat.get(&maps, GOAL.0, GOAL.1, 17), Cost::ZERO);
+    }
+
+    #[test]
+    fn a_past_deadline_freezes_at_a_lower_bound() {
+        let (maps, lattice, driving) = setup();
+        let step = Cost::from_f64_floor(0.3);
+        let exact = CostToGo::new(lattice, &driving, step, GOAL, usize::MAX);
+        let frozen = CostToGo::new(lattice, &driving, step, GOAL, usize::MAX);
+        frozen.set_deadline(Some(Instant::now()));
+        let far = frozen.get(&maps, 2, 2, 40);
+        assert!(frozen.frozen());
+        assert!(far <= exact.get(&maps, 2, 2, 40), "{far}");
+        // Fixed from then on, and below D everywhere.
+        assert_eq!(frozen.get(&maps, 2, 2, 40), far);
+        for (i, j, t) in [(10, 32, 0), (90, 32, 0), (99, 33, 1), (30, 5, 63)] {
+            assert!(frozen.get(&maps, i, j, t) <= exact.get(&maps, i, j, t));
+        }
     }
 }

@@ -510,6 +510,12 @@ impl<'c> HybridGraph<'c> {
         p
     }
 
+    /// Stops the heuristic's cost-to-go from growing after `deadline` (the plan's time
+    /// limit): see `CostToGo::set_deadline`.
+    pub fn set_heuristic_deadline(&self, deadline: Option<Instant>) {
+        self.cost_to_go.set_deadline(deadline);
+    }
+
     /// Base cells the heuristic's cost-to-go has settled so far.
     pub fn cost_to_go_cells(&self) -> usize {
         self.cost_to_go.settled()
