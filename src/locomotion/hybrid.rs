@@ -498,14 +498,18 @@ impl<'c> HybridGraph<'c> {
             return p;
         }
         p.driving = self.driving.heuristic(s);
+        if let Some(o) = self.footprints.get(s.footprint) {
+            p.steps = self.step_bound.lower_bound(self.maps, &self.feet_pos(s, &o));
+            (p.behind, p.ahead) = self.step_bound.offset_potential(&o);
+        }
+        if p.steps.is_infinite() {
+            // No chain of steps reaches the goal: the cost-to-go need not be searched.
+            return p;
+        }
         p.to_go = self.cost_to_go.get(self.maps, s.i, s.j, s.theta);
         if !self.cost_to_go.oriented() {
             // One layer for all orientations: turns are not in it.
             p.to_go = p.to_go.saturating_add(self.driving.turn_heuristic(s));
-        }
-        if let Some(o) = self.footprints.get(s.footprint) {
-            p.steps = self.step_bound.lower_bound(self.maps, &self.feet_pos(s, &o));
-            (p.behind, p.ahead) = self.step_bound.offset_potential(&o);
         }
         p
     }
