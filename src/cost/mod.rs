@@ -351,7 +351,14 @@ impl CostMaps {
     /// height (`Params::driving_leg_height_m`).
     #[inline]
     pub fn driving_pose_cost(&self, pose: &Pose2) -> Cost {
-        let (s, c) = pose.theta.sin_cos();
+        self.driving_pose_cost_sc(pose, pose.theta.sin_cos())
+    }
+
+    /// As [`CostMaps::driving_pose_cost`], with the sine and cosine of the pose's yaw
+    /// given (the same result, bit for bit, for `pose.theta.sin_cos()`): for callers that
+    /// evaluate many poses of a few orientations.
+    #[inline]
+    pub fn driving_pose_cost_sc(&self, pose: &Pose2, (s, c): (f64, f64)) -> Cost {
         let feet = self
             .neutral_footprint
             .map(|[fx, fy]| [pose.x + c * fx - s * fy, pose.y + s * fx + c * fy]);

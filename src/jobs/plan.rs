@@ -457,6 +457,9 @@ fn search(
     cancel: Option<&AtomicBool>,
 ) -> Result<SearchResult<LatticeState>, SearchError> {
     let hooks = Hooks { cancel, ..Hooks::default() };
+    // The heuristic's lazy cost-to-go stops growing at the time limit, so a first query
+    // that would reach far cannot overrun it.
+    graph.set_heuristic_deadline(params.time_limit.map(|t| Instant::now() + t));
     Ok(match algorithm {
         Algorithm::AStar => astar_with_hooks(graph, start, params, hooks),
         Algorithm::AraStar => arastar_with_hooks(graph, start, params, hooks)?,

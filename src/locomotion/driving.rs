@@ -213,6 +213,20 @@ impl<C: PoseCostSource> DrivingGraph<C> {
         c.is_finite().then_some(f64::from(c))
     }
 
+    /// The turn term of the heuristic alone: `r_turn` × the angle still to turn when the
+    /// goal fixes the orientation, else zero (rounded down like the heuristic). Turns
+    /// cost at least their arc and no other move changes θ, so it is consistent on its
+    /// own; the hybrid graph adds it to its base-cell cost-to-go.
+    pub fn turn_heuristic(&self, s: LatticeState) -> Cost {
+        match self.goal.theta {
+            Some(g) => {
+                let steps = self.lattice.orientation_steps_between(s.theta, g);
+                heuristic_cost(f64::from(steps) * self.turn_length)
+            }
+            None => Cost::ZERO,
+        }
+    }
+
     /// The continuous poses of a path.
     pub fn poses(&self, path: &[LatticeState]) -> Vec<Pose2> {
         path.iter().map(|&s| self.lattice.pose(s)).collect()

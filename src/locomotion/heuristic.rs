@@ -62,9 +62,10 @@
 //! (Dijkstra) `≤ c + S_k(B)`, and the other feet's terms do not change. Every other
 //! manoeuvre leaves all four components, hence the bound, unchanged. So `Σ_k S_k` is
 //! consistent on its own with respect to the step edges and invariant on all others; it
-//! is zero at the goal. Added to the driving heuristic (Euclidean distance plus turn,
-//! consistent with respect to drives, turns and base shifts and unchanged by steps and
-//! foot moves), the sum is consistent for every edge of the hybrid graph. Weights are
+//! is zero at the goal. Added to the driving part of the heuristic (the larger of the
+//! Euclidean distance plus turn and the cost-to-go of `cost_to_go`, consistent with
+//! respect to drives, turns and base shifts and unchanged by steps and foot moves), the
+//! sum is consistent for every edge of the hybrid graph. Weights are
 //! rounded down to the micro-unit with a relative slack of 10⁻⁹ (edges round up), and
 //! the Dijkstra sums integers, so the bound holds exactly in fixed point.
 //!
@@ -80,8 +81,11 @@
 //! half a cell diagonal, repeatedly, for as little as `f · k10 · res` (one cell, C_B = 1).
 //! Consistency then caps the rolling weight at C_F ≈ 5, and base shifts are possible
 //! wherever a foot can come close to any obstacle (walls included), i.e. almost
-//! everywhere. The same cap (≈ 3.7 per metre) limits a per-cell bound on base motion
-//! taken from the driving pose costs. Neither is worth its set-up time.
+//! everywhere. The driving cost is bounded per base pose instead, by the cost-to-go of
+//! `cost_to_go` (drives at their real pose costs; base shifts at `f · k10` per cell plus
+//! the rise of the foot-offset potential, `f · (k10 + 4 k11 · C_F,min)` ≈ 10.75 per
+//! metre with the paper's constants: what a crawl of base shifts and foot moves costs at
+//! the least).
 
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::planner::Cost;
@@ -131,14 +135,19 @@ pub struct StepBound {
     /// Per foot (FL, FR, RL, RR), per component: the step cost still needed, S_k.
     per_foot: [Vec<Cost>; 4],
     components: usize,
-    /// Weight of the foot-offset potential per cell of offset, cost units.
-    offset_per_cell: f64,
+    /// Weight c of the foot-offset potential per cell of offset, rounded down.
+    offset_per_cell: Cost,
 }
 
 impl StepBound {
     /// A bound that is zero everywhere.
     pub fn zero() -> Self {
-        Self { comp: Vec::new(), per_foot: Default::default(), components: 0, offset_per_cell: 0.0 }
+        Self {
+            comp: Vec::new(),
+            per_foot: Default::default(),
+            components: 0,
+            offset_per_cell: Cost::ZERO,
+        }
     }
 
     /// Builds the bound on `maps` for the goal foot positions `goal_feet` (one array of
@@ -255,12 +264,13 @@ impl StepBound {
             }
             dist
         });
-        Self { comp, per_foot, components: k, offset_per_cell: offset_per_m * res }
+        let offset_per_cell = Cost::from_f64_floor(offset_per_m * res * (1.0 - 1e-9));
+        Self { comp, per_foot, components: k, offset_per_cell }
     }
 
-    /// The weight c of the foot-offset potential, per metre of offset.
-    pub fn offset_weight_per_m(&self, res: f64) -> f64 {
-        self.offset_per_cell / res
+    /// The weight c of the foot-offset potential per cell of offset (fixed point).
+    pub fn offset_per_cell(&self) -> Cost {
+        self.offset_per_cell
     }
 
     /// Number of components (0 for the zero bound).
@@ -289,12 +299,22 @@ impl StepBound {
         sum
     }
 
-    /// The foot-offset potential Φ = c · Σ_k |o_k| of a footprint with offsets `o`
-    /// (cells), rounded down (see [`offset_potential`]).
+    /// The foot-offset potential Φ = c · Σ_k (o_k⁻ − o_k⁺) of a footprint with offsets
+    /// `o` (cells; o⁻ = max(−o, 0), o⁺ = max(o, 0)), as its two parts `(c · Σ o⁻,
+    /// c · Σ o⁺)`: the heuristic adds the first and subtracts the second (see
+    /// [`offset_potential`]). Exact integers: c is a whole number of micro-units.
     #[inline]
-    pub fn offset_potential(&self, o: &[i8; 4]) -> Cost {
-        let cells: i32 = o.iter().map(|&v| i32::from(v).abs()).sum();
-        Cost::from_f64_floor(self.offset_per_cell * f64::from(cells) * (1.0 - 1e-9))
+    pub fn offset_potential(&self, o: &[i8; 4]) -> (Cost, Cost) {
+        let (mut behind, mut ahead) = (0u64, 0u64);
+        for &v in o {
+            if v < 0 {
+                behind += u64::from(v.unsigned_abs());
+            } else {
+                ahead += u64::from(v.unsigned_abs());
+            }
+        }
+        let c = self.offset_per_cell.0;
+        (Cost(c.saturating_mul(behind)), Cost(c.saturating_mul(ahead)))
     }
 }
 
@@ -493,27 +513,30 @@ fn min_step_lengths(
     Some(StepLengths { lengths, k })
 }
 
-/// The weight c of the foot-offset potential `Φ = c · Σ_k |o_k|` (o_k in metres) that the
-/// hybrid heuristic adds for non-neutral footprints: every offset must be undone before
-/// the (neutral) goal. The largest `c` for which Φ stays consistent:
+/// The weight c of the foot-offset potential `Φ = c · Σ_k (o_k⁻ − o_k⁺)` (o_k in metres,
+/// o⁻ = max(−o, 0), o⁺ = max(o, 0)) that the hybrid heuristic adds for non-neutral
+/// footprints. A foot behind neutral still has to come forward (the goal is neutral);
+/// a foot ahead of it has paid in advance for base motion the base-cell cost-to-go
+/// (`cost_to_go`) still counts. Φ is consistent on its own share of each manoeuvre:
 ///
 /// - foot to neutral / front foot forward drive one foot by |Δo| at cost
-///   `f · k11 · |Δo| · C_F,avg ≥ f · k11 · C_F,min · |Δo|` (eq. 6);
-/// - a base shift by L changes every offset by L (Φ drops by at most 4 c L) and the
-///   Euclidean part of the heuristic by at most the base's move, ≤ L + res/√2 (the snap
-///   to the cell); it costs at least `f · k10 · L` (C_B ≥ 1, eq. 3) and L ≥ res, so
-///   `4 c ≤ f · k10 − 1 − 1/√2` suffices;
+///   `f · k11 · |Δo| · C_F,avg ≥ f · k11 · C_F,min · |Δo|` (eq. 6), and Φ drops by at
+///   most `c · |Δo|`;
 /// - a step changes one offset by L and costs at least `f · k7 · L` beyond what the step
 ///   bound uses when the bound keeps only `(1 − λ) · k7`: `c ≤ λ · f · k7`;
+/// - a base shift by l cells lowers every offset by l, so Φ *rises* by at least
+///   `4 c · l · res` (o⁻ grows or o⁺ shrinks by l, or both add up to l). The cost-to-go
+///   spends that rise: its base-shift links weigh `f · k10 · res + 4 c · res`;
 /// - drives and turns keep the neutral footprint (Φ = 0).
+///
+/// Φ is negative for feet ahead of neutral; the heuristic is clamped at zero, and the
+/// maximum of zero and a consistent heuristic is consistent.
 ///
 /// Returns `(c, λ)` with λ the smallest share of k7 that pays for c (c = 0 when the
 /// constants leave no room). `min_foot_cost` is the smallest finite C_F of the map.
 pub fn offset_potential(params: &StepBoundParams, min_foot_cost: f64) -> (f64, f64) {
     let f = params.step_cost_factor;
-    let c = (f * params.k11 * min_foot_cost)
-        .min((f * params.k10 - 1.0 - std::f64::consts::FRAC_1_SQRT_2) / 4.0)
-        .min(f * params.k7);
+    let c = (f * params.k11 * min_foot_cost).min(f * params.k7);
     if !(c.is_finite() && c > 0.0) {
         return (0.0, 0.0);
     }

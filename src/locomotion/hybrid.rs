@@ -65,28 +65,36 @@
 //!   same issue). The edge cost is `max(C_BS · factor, distance moved)`, which keeps the
 //!   heuristic consistent even for factors below 2.
 //!
-//! **Heuristic** (issue 4), a sum of three parts, each consistent on every manoeuvre:
+//! **Heuristic** (issues 4 and 15): `max(h_E, D) + S + Φ`, clamped at zero, where
 //!
-//! 1. that of [`DrivingGraph`]: Euclidean distance plus the orientation difference times
-//!    the turning radius. Steps and foot moves leave the base in place; drives and base
-//!    shifts cost at least the distance they move the base (pose costs ≥ 1, k_Δθ ≥ 1,
-//!    and a base shift's cost is at least its move); turns cost at least their arc;
-//! 2. the step bound Σ_k S_k of the `heuristic` module: per foot, the cheapest chain of
-//!    steps (C_S, eq. 5, times the step-related factor) from the foot's component of
-//!    finite-C_F cells to the component of its goal position. Only a step moves a foot
-//!    between components, and it costs at least the bound's drop;
-//! 3. the foot-offset potential c · Σ_k |o_k| (offsets in metres; zero for the neutral
-//!    footprint): every offset must be undone before the neutral goal, and each
-//!    manoeuvre that changes offsets pays c per metre — foot moves by eq. 6 (C_F ≥ the
-//!    map's smallest), base shifts by C_BS ≥ f · k10 · L (C_B ≥ 1, eq. 3) with room
-//!    left for part 1, steps by the share λ of eq. 5's k7 term that part 2 leaves out
-//!    (`heuristic::offset_potential`).
+//! 1. `h_E` is that of [`DrivingGraph`]: Euclidean distance plus the orientation
+//!    difference times the turning radius. Steps and foot moves leave the base in place;
+//!    drives and base shifts cost at least the distance they move the base (pose costs
+//!    ≥ 1, k_Δθ ≥ 1, and a base shift's cost is at least its move); turns cost at least
+//!    their arc;
+//! 2. `D` is the cost-to-go of the `cost_to_go` module: a lazy backward Dijkstra over
+//!    (cell, orientation) whose edges relax drives (the pose cost of eq. 4 at that
+//!    orientation, k_Δθ), turns and base shifts (f · k10 per cell, plus Φ's rise);
+//!    consistent on every manoeuvre, with Φ on base shifts. The larger of two consistent
+//!    heuristics is consistent, and both parts leave the same share of each edge's cost
+//!    to the parts below (none of drives and turns, Φ's rise on base shifts, all of
+//!    steps and foot moves);
+//! 3. `S` is the step bound Σ_k S_k of the `heuristic` module: per foot, the cheapest
+//!    chain of steps (C_S, eq. 5, times the step-related factor) from the foot's
+//!    component of finite-C_F cells to the component of its goal position. Only a step
+//!    moves a foot between components, and it costs at least the bound's drop;
+//! 4. `Φ = c · Σ_k (o_k⁻ − o_k⁺)` is the foot-offset potential (offsets in metres; zero
+//!    for the neutral footprint): a foot behind neutral still has to come forward, one
+//!    ahead has paid in advance for base motion `D` counts. Foot moves pay c per metre by
+//!    eq. 6 (C_F ≥ the map's smallest), steps by the share λ of eq. 5's k7 term that `S`
+//!    leaves out; a base shift raises Φ (`heuristic::offset_potential`).
 //!
-//! Part 2 is zero where no step is needed and part 3 for the neutral footprint, so a
-//! driving state on flat ground gets part 1 alone, as before. The
-//! proofs are in the `heuristic` module docs; `locomotion::tests` checks
-//! `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge.
+//! `S` is zero where no step is needed and Φ for the neutral footprint. The proofs are
+//! in the `cost_to_go` and `heuristic` module docs; `locomotion::tests` checks
+//! `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge and
+//! on random walks over random small maps, and that A*'s optimum does not change.
 
+use super::cost_to_go::CostToGo;
 use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, edge_cost};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{StepBound, StepBoundParams};
@@ -212,6 +220,9 @@ pub struct HybridConfig {
     pub foot_move_increment_m: f64,
     /// Cap on distinct footprints (graph size guard).
     pub max_footprints: usize,
+    /// Most (cell, orientation) nodes for which the heuristic's cost-to-go keeps one
+    /// layer per orientation (`cost_to_go::MAX_ORIENTED_NODES`); above, one layer.
+    pub max_oriented_nodes: usize,
     /// Driving leg height (Sec. VI-B), m: the driving posture the feasibility model checks.
     pub driving_leg_height_m: f64,
     /// Smallest stability margin of a posture, m (the generator's requirement).
@@ -251,6 +262,7 @@ impl HybridConfig {
             step_support_margin_m: params.step_support_margin_m,
             foot_move_increment_m: 0.1,
             max_footprints: 65_536,
+            max_oriented_nodes: super::cost_to_go::MAX_ORIENTED_NODES,
             driving_leg_height_m: params.driving_leg_height_m,
             min_stability_margin_m: params.min_stability_margin_m,
             base_circle_radius_m: params.base_circle_radius_m,
@@ -322,6 +334,9 @@ pub struct HybridGraph<'c> {
     stats: ManoeuvreStats,
     /// The step-cost part of the heuristic (`heuristic`), built once per graph.
     step_bound: StepBound,
+    /// The driving and base-shift part of the heuristic (`cost_to_go`): a backward
+    /// Dijkstra over base cells, run lazily as far as the queries need.
+    cost_to_go: CostToGo,
     /// Time spent building `step_bound`.
     heuristic_setup: Duration,
     /// [`Self::target_ok`] of non-neutral footprints by (cell, orientation, offsets): a
@@ -331,6 +346,25 @@ pub struct HybridGraph<'c> {
     /// [`Self::step_feasible`] by the state a step starts from, the leg and its new
     /// offset: ARA* expands a state again in each iteration.
     step_checks: HashMap<(PoseKey, u8, i8), bool, FxBuild>,
+}
+
+/// The parts of the hybrid heuristic of a state (`HybridGraph::heuristic_parts`):
+/// `h = max(driving, to_go) + steps + behind − ahead`, clamped at zero, or infinite
+/// when `reachable` is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HeuristicParts {
+    /// Infinite when the base cell cannot reach the goal at all (`reachability`).
+    pub reachable: Cost,
+    /// Euclidean distance plus turn (`driving`).
+    pub driving: Cost,
+    /// The base-cell cost-to-go (`cost_to_go`).
+    pub to_go: Cost,
+    /// The step bound Σ_k S_k (`heuristic`).
+    pub steps: Cost,
+    /// Φ's part for feet behind neutral, c · Σ o⁻.
+    pub behind: Cost,
+    /// Φ's part for feet ahead of neutral, c · Σ o⁺ (subtracted).
+    pub ahead: Cost,
 }
 
 /// A lattice state by what it means, not by this graph's footprint ids: cell,
@@ -410,6 +444,18 @@ impl<'c> HybridGraph<'c> {
         let near = near_obstacle_layer(maps, config.step_obstacle_distance_m);
         let t0 = Instant::now();
         let step_bound = build_step_bound(maps, &near, &config, &lattice, goal);
+        // A base shift costs at least f · k10 per metre (C_B ≥ 1) and raises the
+        // foot-offset potential by 4 c per cell (`heuristic::offset_potential`).
+        let shift_step =
+            Cost::from_f64_floor(config.step_cost_factor * config.k10 * res * (1.0 - 1e-9))
+                .saturating_add(Cost(step_bound.offset_per_cell().0.saturating_mul(4)));
+        let cost_to_go = CostToGo::new(
+            lattice,
+            &config.driving,
+            shift_step,
+            (goal.i, goal.j, goal.theta),
+            config.max_oriented_nodes,
+        );
         let regions = BaseRegions::build(
             maps,
             robot,
@@ -448,6 +494,7 @@ impl<'c> HybridGraph<'c> {
             special: Vec::with_capacity(16),
             stats: ManoeuvreStats::default(),
             step_bound,
+            cost_to_go,
             heuristic_setup,
             standable: HashMap::default(),
             step_checks: HashMap::default(),
@@ -458,6 +505,48 @@ impl<'c> HybridGraph<'c> {
     /// of any search's time).
     pub fn heuristic_setup_time(&self) -> Duration {
         self.heuristic_setup
+    }
+
+    /// The parts of the heuristic of `s` (see [`HeuristicParts`]).
+    pub fn heuristic_parts(&self, s: LatticeState) -> HeuristicParts {
+        let mut p = HeuristicParts {
+            reachable: Cost::ZERO,
+            driving: Cost::ZERO,
+            to_go: Cost::ZERO,
+            steps: Cost::ZERO,
+            behind: Cost::ZERO,
+            ahead: Cost::ZERO,
+        };
+        if !self.regions.reachable(s.i, s.j) {
+            p.reachable = Cost::INFINITY;
+            return p;
+        }
+        p.driving = self.driving.heuristic(s);
+        if let Some(o) = self.footprints.get(s.footprint) {
+            p.steps = self.step_bound.lower_bound(self.maps, &self.feet_pos(s, &o));
+            (p.behind, p.ahead) = self.step_bound.offset_potential(&o);
+        }
+        if p.steps.is_infinite() {
+            // No chain of steps reaches the goal: the cost-to-go need not be searched.
+            return p;
+        }
+        p.to_go = self.cost_to_go.get(self.maps, s.i, s.j, s.theta);
+        if !self.cost_to_go.oriented() {
+            // One layer for all orientations: turns are not in it.
+            p.to_go = p.to_go.saturating_add(self.driving.turn_heuristic(s));
+        }
+        p
+    }
+
+    /// Stops the heuristic's cost-to-go from growing after `deadline` (the plan's time
+    /// limit): see `CostToGo::set_deadline`.
+    pub fn set_heuristic_deadline(&self, deadline: Option<Instant>) {
+        self.cost_to_go.set_deadline(deadline);
+    }
+
+    /// Base cells the heuristic's cost-to-go has settled so far.
+    pub fn cost_to_go_cells(&self) -> usize {
+        self.cost_to_go.settled()
     }
 
     /// Number of foot components the step bound found (0: no step bound).
@@ -1227,20 +1316,22 @@ impl SearchGraph for HybridGraph<'_> {
         }
     }
 
-    /// The driving heuristic (Euclidean distance plus turn, [`DrivingGraph`]) plus the
-    /// step bound Σ_k S_k of the four feet (`heuristic` module): consistent on every
-    /// manoeuvre (see the module docs of both).
+    /// The larger of the driving heuristic (Euclidean distance plus turn,
+    /// [`DrivingGraph`]) and the base-cell cost-to-go (`cost_to_go`), plus the step
+    /// bound Σ_k S_k of the four feet and the foot-offset potential Φ (`heuristic`
+    /// module), clamped at zero: consistent on every manoeuvre (see the module docs of
+    /// all three and of this module).
     fn heuristic(&self, s: LatticeState) -> Cost {
-        if !self.regions.reachable(s.i, s.j) {
+        let p = self.heuristic_parts(s);
+        if p.reachable.is_infinite() {
             return Cost::INFINITY;
         }
-        let h = self.driving.heuristic(s);
-        let Some(o) = self.footprints.get(s.footprint) else {
+        let h = p.driving.max(p.to_go).saturating_add(p.steps).saturating_add(p.behind);
+        if h.is_infinite() {
             return h;
-        };
-        let feet = self.feet_pos(s, &o);
-        h.saturating_add(self.step_bound.lower_bound(self.maps, &feet))
-            .saturating_add(self.step_bound.offset_potential(&o))
+        }
+        // Clamped at zero (feet ahead of neutral have paid in advance).
+        h.saturating_sub(p.ahead)
     }
 
     fn is_goal(&self, s: LatticeState) -> bool {

@@ -8,6 +8,9 @@
 //! - [`driving`]: the driving graph (moves and turns on the spot, their costs, the
 //!   heuristic) and `plan_driving`.
 //! - [`footprint`]: footprints (per-leg longitudinal foot offsets) interned as small ids.
+//! - [`cost_to_go`]: the driving part of the hybrid heuristic — a lazy backward Dijkstra
+//!   over base cells whose edges relax drives (the smallest pose cost over orientations,
+//!   eq. 4) and base shifts; consistent on every manoeuvre.
 //! - [`heuristic`]: the informed part of the hybrid heuristic — a lower bound on the step
 //!   costs (eq. 5) each foot still needs, and the foot-offset potential; built once per
 //!   graph.
@@ -17,6 +20,7 @@
 //! - [`hybrid`]: the full hybrid graph — driving plus abstract steps, base shifts and
 //!   single-foot moves (Sec. V), with their costs C_S (eq. 5), C_BS and C_FM (eq. 6).
 
+pub mod cost_to_go;
 pub mod driving;
 pub mod footprint;
 pub mod heuristic;
@@ -34,8 +38,8 @@ pub use driving::{
 };
 pub use footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 pub use hybrid::{
-    HybridConfig, HybridGraph, Manoeuvre, ManoeuvreKind, ManoeuvreStats, PoseKey, StepCost,
-    base_shift_cost, foot_move_cost, step_cost,
+    HeuristicParts, HybridConfig, HybridGraph, Manoeuvre, ManoeuvreKind, ManoeuvreStats, PoseKey,
+    StepCost, base_shift_cost, foot_move_cost, step_cost,
 };
 pub use lattice::{Lattice, LatticeError, LatticeState, Move, NEUTRAL_FOOTPRINT, Neighbourhood};
 pub use orientation::OrientationFactor;
