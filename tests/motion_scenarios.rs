@@ -7,6 +7,8 @@
 //! (`motion::standing`), so every planned footprint can be stood in; the planner's support
 //! check keeps steps the alignment manoeuvres can stabilise.
 
+mod common;
+
 use momaro::jobs::plan::{self, PathElement, PathKind, PlanOptions, PlanSummary};
 use momaro::locomotion::Algorithm;
 use momaro::motion::{DetailedPath, MotionError, MotionOptions, Phase, expand_path};
@@ -239,4 +241,29 @@ height = 0.1
     let back = d.keyframes.iter().find(|k| k.phase == Phase::ShiftBack).expect("shifted back");
     assert!(back.base_position[0].abs() < 1e-9, "{:?}", back.base_position);
     assert!(d.keyframes.iter().any(|k| k.phase == Phase::Place && k.leg == Some(Leg::FrontLeft)));
+}
+
+/// The planner runs the generator's own step check (`motion::expand::step_motion`) from
+/// the standing posture the generator settles into, so a planned step expands. Two
+/// generated courses (`momaro generate --class up_and_over --seed 59` and `--seed 83`)
+/// whose first plans the generator rejected before the planner did so: a front step
+/// whose swing held 2.96 cm of margin against 3 cm, and a rear step whose stepping leg
+/// came out of reach in the generator's re-centred stance.
+#[test]
+fn generated_step_courses_expand_as_planned() {
+    use momaro::jobs::generate::checked_case;
+    use momaro::scenario::generate::Class;
+    let mut sim = sim();
+    let robot = sim.robot().clone();
+    let dir = common::temp_dir("generated_step_courses");
+    for seed in [59, 83] {
+        let (case, _) = checked_case(Class::UpAndOver, seed, &dir, &robot).expect("generated");
+        let s = case.scenario(&dir).expect("scenario");
+        let p = planned(&s, &sim);
+        assert!(p.steps > 0, "{}: no steps planned", s.name);
+        let d = expand(&s, &mut sim, &p.path).unwrap_or_else(|e| panic!("{}: {e}", s.name));
+        report(&s, p.path.len(), p.path.len(), &d);
+        check(&d, &sim);
+        assert_eq!(d.steps, p.steps);
+    }
 }

@@ -6,7 +6,9 @@
 //! detour and the steps differ by a few percent), so they run ARA* to ε = 1; the others
 //! use ARA* with a time limit.
 
-use momaro::jobs::plan::{PathElement, PathKind, PlanJobError, PlanOptions, PlanSummary, run};
+use momaro::jobs::plan::{
+    self, PathElement, PathKind, PlanJobError, PlanOptions, PlanSummary, run,
+};
 use momaro::locomotion::Algorithm;
 use momaro::robot::RobotDescription;
 use momaro::scenario::Scenario;
@@ -216,6 +218,31 @@ fn two_runs_give_identical_paths() {
     assert_eq!(a.termination, "final_epsilon_reached");
     assert_eq!(a.path, b.path);
     assert_eq!(a.cost, b.cost);
+}
+
+#[test]
+fn a_replan_starts_from_the_nearest_pose_a_plan_can_start_from() {
+    let base = std::fs::read_to_string(scenario_path("flat")).expect("read");
+    let parse = |text: &str| Scenario::parse(text, Path::new("test.toml")).expect("parse");
+    // A wall 0.5 m to the left: the left wheels (0.32 m out) stand within r_F of it, so
+    // no plan starts here (the same case as the bad-start error below).
+    let walled = parse(&format!(
+        "{base}\n[[terrain]]\nkind = \"box\"\ncenter = [0.0, 0.5]\nsize = [2.0, 0.1]\nheight = 0.5\n"
+    ));
+    let robot = robot();
+    assert!(matches!(
+        plan::prepare(&walled, &robot, None, None),
+        Err(PlanJobError::Untraversable { .. })
+    ));
+    let start = plan::nearest_start(&walled, &robot, 0.15).expect("maps");
+    let moved = start.distance(&walled.start);
+    assert!(moved > 0.0 && moved <= 0.15 + 1e-9, "moved {moved}");
+    let mut from_there = walled.clone();
+    from_there.start = start;
+    plan::prepare(&from_there, &robot, None, None).expect("a plan starts there");
+    // Where a plan can start, the start is kept.
+    let flat = parse(&base);
+    assert_eq!(plan::nearest_start(&flat, &robot, 0.15).expect("maps"), flat.start);
 }
 
 #[test]

@@ -357,18 +357,7 @@ pub fn prepare(
         params.step_cost_factor = f;
     }
     params.validate().map_err(|source| PlanJobError::Params { scenario: file(), source })?;
-    let m = &scenario.map;
-    let heights = rasterise(
-        &scenario.terrain,
-        [m.x_min, m.y_min],
-        [m.x_max - m.x_min, m.y_max - m.y_min],
-        params.grid_resolution_m,
-    )
-    .map_err(|source| PlanJobError::Map { scenario: file(), source })?;
-    let maps = CostMaps::build(&heights, robot, &params)
-        .map_err(|source| PlanJobError::Cost { scenario: file(), source })?;
-    let lattice = crate::locomotion::Lattice::for_map(maps.heights(), params.orientations)
-        .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
+    let (maps, lattice) = build_maps(scenario, robot, &params)?;
     let mut states = [LatticeState::new(0, 0, 0); 2];
     for (k, (which, pose)) in
         [("start", scenario.start), ("goal", scenario.goal)].into_iter().enumerate()
@@ -381,24 +370,7 @@ pub fn prepare(
                 bounds: maps.heights().bounds(),
             });
         };
-        let fits = || {
-            crate::feasibility::DrivingCheck::new(robot, &params)
-                .lattice_pose(&maps, &lattice.pose(s))
-                .is_ok()
-        };
-        let reason = match maps.driving_pose_cost(&lattice.pose(s)) {
-            CostValue::Finite(_) if fits() => None,
-            CostValue::Finite(_) => Some(
-                "the legs or the body do not fit there, driving or standing (the feasibility model the planner and the motion generator share)",
-            ),
-            CostValue::Infinite => Some(
-                "a wheel stands on or next to an untraversable height difference (infinite foot cost)",
-            ),
-            CostValue::Unknown => {
-                Some("the robot stands on unknown terrain or reaches off the map")
-            }
-        };
-        if let Some(reason) = reason {
+        if let Some(reason) = unfit(robot, &params, &maps, &lattice.pose(s)) {
             return Err(PlanJobError::Untraversable { scenario: file(), which, pose, reason });
         }
         states[k] = s;
@@ -410,6 +382,114 @@ pub fn prepare(
         goal: states[1],
         setup_time_s: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// The height and cost maps of `scenario` with `params`, and the lattice over them.
+fn build_maps(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    params: &Params,
+) -> Result<(CostMaps, crate::locomotion::Lattice), PlanJobError> {
+    let file = || scenario.path.clone();
+    let m = &scenario.map;
+    let heights = rasterise(
+        &scenario.terrain,
+        [m.x_min, m.y_min],
+        [m.x_max - m.x_min, m.y_max - m.y_min],
+        params.grid_resolution_m,
+    )
+    .map_err(|source| PlanJobError::Map { scenario: file(), source })?;
+    let maps = CostMaps::build(&heights, robot, params)
+        .map_err(|source| PlanJobError::Cost { scenario: file(), source })?;
+    let lattice = crate::locomotion::Lattice::for_map(maps.heights(), params.orientations)
+        .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
+    Ok((maps, lattice))
+}
+
+/// Why the robot cannot start or end at lattice pose `pose`, if it cannot: the driving
+/// pose cost must be finite and the feasibility model must fit the robot there.
+fn unfit(
+    robot: &RobotDescription,
+    params: &Params,
+    maps: &CostMaps,
+    pose: &Pose2,
+) -> Option<&'static str> {
+    match maps.driving_pose_cost(pose) {
+        CostValue::Finite(_)
+            if crate::feasibility::DrivingCheck::new(robot, params)
+                .lattice_pose(maps, pose)
+                .is_ok() =>
+        {
+            None
+        }
+        CostValue::Finite(_) => Some(
+            "the legs or the body do not fit there, driving or standing (the feasibility model the planner and the motion generator share)",
+        ),
+        CostValue::Infinite => Some(
+            "a wheel stands on or next to an untraversable height difference (infinite foot cost)",
+        ),
+        CostValue::Unknown => Some("the robot stands on unknown terrain or reaches off the map"),
+    }
+}
+
+/// The pose a replan starts from: `scenario.start` if the planner can start there, else
+/// the nearest lattice pose within `radius_m` and two orientation steps that it can (the
+/// nearest first, then the smaller turn), else `scenario.start` (whose planning then
+/// fails with [`PlanJobError::Untraversable`]). A robot that stopped mid-manoeuvre may
+/// stand with a wheel next to an edge, where no plan may start; the path follower takes
+/// it from where it stands to the new path's first pose.
+///
+/// # Errors
+/// Invalid parameters or an unbuildable map.
+pub fn nearest_start(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    radius_m: f64,
+) -> Result<Pose2, PlanJobError> {
+    let params = scenario.params.clone();
+    params
+        .validate()
+        .map_err(|source| PlanJobError::Params { scenario: scenario.path.clone(), source })?;
+    let (maps, lattice) = build_maps(scenario, robot, &params)?;
+    let start = scenario.start;
+    let Some(s) = lattice.state(&start) else {
+        return Ok(start);
+    };
+    if unfit(robot, &params, &maps, &lattice.pose(s)).is_none() {
+        return Ok(start);
+    }
+    let r = (radius_m / lattice.resolution).ceil() as i32;
+    let n = i32::from(lattice.orientations);
+    let mut candidates = Vec::new();
+    for di in -r..=r {
+        for dj in -r..=r {
+            let d = f64::from(di).hypot(f64::from(dj)) * lattice.resolution;
+            if d > radius_m {
+                continue;
+            }
+            for dt in [0_i32, 1, -1, 2, -2] {
+                candidates.push((d, dt.abs(), di, dj, dt));
+            }
+        }
+    }
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (_, _, di, dj, dt) in candidates {
+        let (i, j) = (i32::from(s.i) + di, i32::from(s.j) + dj);
+        let (Ok(i), Ok(j)) = (i16::try_from(i), i16::try_from(j)) else { continue };
+        if i < 0
+            || j < 0
+            || i32::from(i) >= i32::from(lattice.nx)
+            || i32::from(j) >= i32::from(lattice.ny)
+        {
+            continue;
+        }
+        let theta = (i32::from(s.theta) + dt).rem_euclid(n) as u8;
+        let pose = lattice.pose(LatticeState::new(i, j, theta));
+        if unfit(robot, &params, &maps, &pose).is_none() {
+            return Ok(pose);
+        }
+    }
+    Ok(start)
 }
 
 impl Prepared {

@@ -468,6 +468,11 @@ pub fn plan_mission(
     }
 }
 
+/// How far from where the robot stopped a replan may start when no plan can start there
+/// (a wheel next to an edge after an aborted manoeuvre), m: a little more than the paper's
+/// foot radius r_F (0.12 m), within which an edge makes a wheel's cell untraversable.
+pub const REPLAN_START_RADIUS_M: f64 = 0.15;
+
 /// Manoeuvres the generator may reject in one planning before the run gives up with a
 /// motion-generation failure.
 pub const MAX_REJECTED_MANOEUVRES: usize = 8;
@@ -671,7 +676,12 @@ pub fn execute(
                 from_here.start = truth;
                 let replan_opts =
                     PlanOptions { time_limit_s: opts.replan_time_limit_s, ..opts.plan.clone() };
-                let result = plan_mission(&from_here, sim, &replan_opts);
+                let result = plan::nearest_start(&from_here, &robot, REPLAN_START_RADIUS_M)
+                    .map_err(RunJobError::from)
+                    .and_then(|start| {
+                        from_here.start = start;
+                        plan_mission(&from_here, sim, &replan_opts)
+                    });
                 replan_wall += t.elapsed().as_secs_f64();
                 match result {
                     Ok(m) => {
