@@ -287,7 +287,9 @@ impl CostToGo {
             let d = search.dist[c];
             search.done[c] = true;
             search.settled += 1;
-            if search.settled % 1024 == 0 && search.deadline.is_some_and(|t| Instant::now() >= t) {
+            if search.settled.is_multiple_of(1024)
+                && search.deadline.is_some_and(|t| Instant::now() >= t)
+            {
                 search.frozen = Some(search.queue.floor());
             }
             let (cell, t) = (c / layers, c % layers);
