@@ -21,11 +21,11 @@ pub mod foot;
 pub mod pose;
 
 pub use body::{BodyGeometry, DiscMaxLayer};
-pub use foot::{FootCostLayer, height_differences};
+pub use foot::{FootCostLayer, HeadingBin, WheelPair, height_differences};
 pub use pose::{PoseCost, PoseWeights, combine};
 
 use crate::geometry::Pose2;
-use crate::params::{InvalidParam, Params};
+use crate::params::{FootModel, InvalidParam, Params};
 use crate::robot::RobotDescription;
 use crate::terrain::HeightMap;
 
@@ -98,6 +98,8 @@ pub struct CostMaps {
     /// Per cell `[C_F raw, height raw]` (`NaN` unknown, `+∞` infinite C_F): a foot's two
     /// look-ups share one cache line, which matters for scattered queries.
     foot_cells: Vec<[f64; 2]>,
+    /// Whether C_F depends on the foot heading (the wheel-pair foot model).
+    foot_oriented: bool,
     disc_max: DiscMaxLayer,
     /// Heights dilated by two cells (5 cm): the terrain a leg point must clear.
     leg_terrain: HeightMap,
@@ -141,11 +143,28 @@ impl CostMaps {
             k2: params.k2,
             k3: params.k3,
         };
-        let foot = FootCostLayer::compute(map, params);
+        let foot = match params.foot_model {
+            FootModel::Paper => FootCostLayer::compute(map, params),
+            FootModel::WheelPair => {
+                let positive = |field: &'static str, value: f64| {
+                    if value.is_finite() && value > 0.0 {
+                        Ok(value)
+                    } else {
+                        Err(CostError::BadRobot { field, value })
+                    }
+                };
+                let wheels = WheelPair {
+                    radius: positive("wheel_radius", robot.wheel_radius)?,
+                    track: check("wheel_track", robot.wheel_track)?.abs(),
+                };
+                FootCostLayer::wheel_pair(map, params, wheels)
+            }
+        };
         let foot_cells =
             map.as_slice().iter().enumerate().map(|(k, &h)| [foot.raw(k), h]).collect();
         Ok(Self {
             heights: map.clone(),
+            foot_oriented: params.foot_model != FootModel::Paper,
             foot,
             foot_cells,
             disc_max: DiscMaxLayer::compute(map, params.base_circle_radius_m),
@@ -203,16 +222,53 @@ impl CostMaps {
         }
     }
 
-    /// C_F (eq. 1) of cell (i, j); `Unknown` off the map.
+    /// C_F (eq. 1) of cell (i, j); `Unknown` off the map. With the wheel-pair foot model
+    /// (`Params::foot_model`), the cost at the cell's most favourable foot heading: a
+    /// lower bound for relaxations and images; poses use [`Self::foot_cost_cell_at`].
     #[inline]
     pub fn foot_cost_cell(&self, i: usize, j: usize) -> Cost {
         self.foot.get(i, j)
+    }
+
+    /// The foot-cost layer's bin for a foot heading `theta` (rad); a foot's heading is
+    /// its base's (the wheels stand straight while stepping and driving forward).
+    #[inline]
+    pub fn foot_heading_bin(&self, theta: f64) -> HeadingBin {
+        self.foot.heading_bin(theta)
+    }
+
+    /// C_F (eq. 1–2) of cell (i, j) for a foot at heading bin `bin`; `Unknown` off the
+    /// map. Equal to [`Self::foot_cost_cell`] with the paper's foot model.
+    #[inline]
+    pub fn foot_cost_cell_at(&self, i: usize, j: usize, bin: HeadingBin) -> Cost {
+        self.foot.get_at(i, j, bin)
+    }
+
+    /// Whether cell (i, j) has infinite C_F at some foot heading (with the paper's
+    /// model: whether it is infinite); `false` off the map. A superset of every
+    /// heading's infinite cells, for pre-filters.
+    #[inline]
+    pub fn foot_cost_infinite_at_some_heading(&self, i: usize, j: usize) -> bool {
+        let (nx, ny) = self.heights.dims();
+        i < nx && j < ny && self.foot.infinite_at_some_heading(j * nx + i)
     }
 
     /// Whether any cell whose centre is closer than `radius` to (x, y) has infinite C_F:
     /// the paper's first step criterion (Sec. V, "close to an obstacle"). Scans the disc
     /// (about 50 cells for 0.1 m); no allocation.
     pub fn infinite_foot_cost_within(&self, x: f64, y: f64, radius: f64) -> bool {
+        self.infinite_foot_cost_within_at(x, y, radius, None)
+    }
+
+    /// As [`Self::infinite_foot_cost_within`], with C_F at heading bin `bin` (the most
+    /// favourable heading's for `None`).
+    pub fn infinite_foot_cost_within_at(
+        &self,
+        x: f64,
+        y: f64,
+        radius: f64,
+        bin: Option<HeadingBin>,
+    ) -> bool {
         let res = self.heights.resolution();
         let o = self.heights.origin();
         let (nx, ny) = self.heights.dims();
@@ -230,7 +286,12 @@ impl CostMaps {
         for j in j0 as usize..=j1 as usize {
             for i in i0 as usize..=i1 as usize {
                 let c = self.heights.cell_center(i, j);
-                if (c[0] - x).hypot(c[1] - y) < radius && self.foot.raw(j * nx + i).is_infinite() {
+                let k = j * nx + i;
+                let v = match bin {
+                    Some(b) => self.foot.raw_at(k, b),
+                    None => self.foot.raw(k),
+                };
+                if (c[0] - x).hypot(c[1] - y) < radius && v.is_infinite() {
                     return true;
                 }
             }
@@ -317,7 +378,10 @@ impl CostMaps {
         feet: &[[f64; 2]; 4],
         leg_heights: &[f64; 4],
     ) -> PoseCost {
-        // One cell look-up per foot serves both its C_F and its ground height.
+        // One cell look-up per foot serves both its C_F and its ground height. The feet's
+        // heading is the base's: the neutral footprint and the step stances stand with
+        // straight wheels.
+        let bin = self.foot.heading_bin(pose.theta);
         let mut feet_cost = [Cost::Unknown; 4];
         let mut ground = [0.0; 4];
         let mut ground_known = true;
@@ -329,6 +393,7 @@ impl CostMaps {
             match cell {
                 Some(idx) => {
                     let [cf, h] = self.foot_cells[idx];
+                    let cf = if self.foot_oriented { self.foot.raw_at(idx, bin) } else { cf };
                     feet_cost[k] = Cost::from_raw(cf);
                     if h.is_nan() {
                         ground_known = false;
