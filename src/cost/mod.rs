@@ -299,6 +299,27 @@ impl CostMaps {
         false
     }
 
+    /// Whether every neutral foot at `pose` has a finite C_F with its wheel pair steered
+    /// for a drive: to the world direction `direction` of a straight move, or, for `None`
+    /// (turning on the spot), across the line to the base centre (the steering of
+    /// `control::wheels`, whose pair rolls along the foot's velocity). Always true with
+    /// the paper's foot model, whose cost does not depend on the heading: the wheel-pair
+    /// model's pose costs assume straight wheels, and a drive steers them.
+    pub fn steered_feet_fit(&self, pose: &Pose2, direction: Option<f64>) -> bool {
+        if !self.foot_oriented {
+            return true;
+        }
+        let feet = self.neutral_feet(pose);
+        feet.iter().zip(&self.neutral_footprint).all(|(f, n)| {
+            let heading = direction.unwrap_or(pose.theta + n[0].atan2(-n[1]));
+            let bin = self.foot.heading_bin(heading);
+            self.heights
+                .cell_of(f[0], f[1])
+                .and_then(|(i, j)| self.heights.index(i, j))
+                .is_some_and(|k| self.foot.raw_at(k, bin).is_finite())
+        })
+    }
+
     /// World positions of the neutral footprint's feet (FL, FR, RL, RR) at `pose`.
     #[inline]
     pub fn neutral_feet(&self, pose: &Pose2) -> [[f64; 2]; 4] {

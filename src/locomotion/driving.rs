@@ -12,7 +12,11 @@
 //!   wheel travel would cost as a drive).
 //!
 //! Pose costs below 1 are raised to 1 (the paper's costs are ≥ 1; the heuristic relies
-//! on it); untraversable or unknown poses have no edges into them. Only the two end
+//! on it); untraversable or unknown poses have no edges into them. A foot model that
+//! depends on the foot heading (`Params::foot_model = wheel_pair`) prices poses with
+//! straight wheels, while a drive steers every pair along its velocity: such a move or
+//! turn also needs both end poses' feet to fit with the pairs steered so
+//! ([`PoseCostSource::steered_fit`]); the paper's model always fits. Only the two end
 //! poses of a move are checked: a two-cell move could hop a one-cell-wide untraversable
 //! line, which the cost client never produces (infinite foot costs are dilated by
 //! r_F = 0.12 m, about five cells).
@@ -45,11 +49,23 @@ pub trait PoseCostSource {
     /// Pose cost C (eq. 4) of the neutral footprint at `pose` with driving leg heights;
     /// `None` where the pose is untraversable or unknown.
     fn driving_cost(&self, pose: &Pose2) -> Option<f64>;
+
+    /// Whether the wheel pairs fit the terrain at `pose` when steered for a drive in world
+    /// direction `direction` (`None`: a turn on the spot). The pose cost assumes straight
+    /// wheels; a foot model that depends on the heading checks the steering here
+    /// (`CostMaps::steered_feet_fit`). Default: they fit.
+    fn steered_fit(&self, _pose: &Pose2, _direction: Option<f64>) -> bool {
+        true
+    }
 }
 
 impl PoseCostSource for &crate::cost::CostMaps {
     fn driving_cost(&self, pose: &Pose2) -> Option<f64> {
         self.driving_pose_cost(pose).finite()
+    }
+
+    fn steered_fit(&self, pose: &Pose2, direction: Option<f64>) -> bool {
+        self.steered_feet_fit(pose, direction)
     }
 }
 
@@ -227,6 +243,7 @@ impl<C: PoseCostSource> SearchGraph for DrivingGraph<C> {
             return;
         }
         let Some(cs) = self.pose_cost(s) else { return };
+        let from = self.lattice.pose(s);
         let row = usize::from(s.theta) * self.moves.len();
         for idx in 0..self.moves.len() {
             let m = self.moves[idx];
@@ -242,7 +259,10 @@ impl<C: PoseCostSource> SearchGraph for DrivingGraph<C> {
             {
                 continue;
             }
-            if let Some(ct) = self.pose_cost(t) {
+            if let Some(ct) = self.pose_cost(t)
+                && self.costs.steered_fit(&from, Some(m.direction))
+                && self.costs.steered_fit(&self.lattice.pose(t), Some(m.direction))
+            {
                 let w = self.move_weight[row + idx];
                 out.push((t, edge_cost(w * 0.5 * (cs + ct))));
             }
@@ -257,7 +277,10 @@ impl<C: PoseCostSource> SearchGraph for DrivingGraph<C> {
         };
         for &theta in turns {
             let t = LatticeState { theta, ..s };
-            if let Some(ct) = self.pose_cost(t) {
+            if let Some(ct) = self.pose_cost(t)
+                && self.costs.steered_fit(&from, None)
+                && self.costs.steered_fit(&self.lattice.pose(t), None)
+            {
                 out.push((t, edge_cost(self.turn_length * 0.5 * (cs + ct))));
             }
         }

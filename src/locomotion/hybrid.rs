@@ -327,6 +327,10 @@ impl PoseCostSource for FeasibleDriving<'_> {
         let cost = self.maps.driving_pose_cost(pose).finite()?;
         self.check.lattice_pose(self.maps, pose).ok().map(|()| cost)
     }
+
+    fn steered_fit(&self, pose: &Pose2, direction: Option<f64>) -> bool {
+        self.maps.steered_feet_fit(pose, direction)
+    }
 }
 
 /// The offsets (cells, −64..=63) at which `leg` reaches its foot with the hip `height`
