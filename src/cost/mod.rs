@@ -213,11 +213,25 @@ impl CostMaps {
         self.heights.height_at_cell(x, y)
     }
 
-    /// C_F (eq. 1) of the cell containing (x, y); `Unknown` off the map.
+    /// C_F (eq. 1) of the cell containing (x, y); `Unknown` off the map. With the
+    /// wheel-pair foot model, at the most favourable heading (see
+    /// [`Self::foot_cost_cell`]); a foot of known heading uses
+    /// [`Self::foot_cost_at_heading`].
     #[inline]
     pub fn foot_cost_at(&self, x: f64, y: f64) -> Cost {
         match self.heights.cell_of(x, y) {
             Some((i, j)) => self.foot.get(i, j),
+            None => Cost::Unknown,
+        }
+    }
+
+    /// C_F (eq. 1–2) of the cell containing (x, y) for a foot facing `theta` (rad; a
+    /// foot faces its base's heading); `Unknown` off the map. Equal to
+    /// [`Self::foot_cost_at`] with the paper's foot model.
+    #[inline]
+    pub fn foot_cost_at_heading(&self, x: f64, y: f64, theta: f64) -> Cost {
+        match self.heights.cell_of(x, y) {
+            Some((i, j)) => self.foot.get_at(i, j, self.foot.heading_bin(theta)),
             None => Cost::Unknown,
         }
     }
@@ -665,6 +679,42 @@ mod tests {
         assert!(finite(d.feet[0]) > 1.0 && d.feet[2] == Cost::Finite(1.0), "{d:?}");
         assert!(finite(d.total) > 1.0);
         assert!(!low.infinite_foot_cost_within(2.9625, 2.5125, 0.3));
+    }
+
+    #[test]
+    fn wheel_pair_fits_a_foot_facing_an_edge_the_paper_disc_does_not() {
+        // A 0.17 m step whose edge lies at x = 3.075: ΔH marks cells 122 (centre
+        // 3.0625) and 123. The front feet stand on cell 118 (centre 2.9625), 4 cells =
+        // 0.1 m from the nearest marked cell.
+        let prims =
+            [Primitive::Box { center: [4.025, 2.5], size: [1.9, 5.0], height: 0.17, yaw_deg: 0.0 }];
+        let m = rasterise(&prims, [0.0, 0.0], [5.0, 5.0], RES).unwrap();
+        let paper = CostMaps::build(&m, &robot(), &Params::default()).unwrap();
+        let wp_params = Params { foot_model: FootModel::WheelPair, ..Params::default() };
+        let wp = CostMaps::build(&m, &robot(), &wp_params).unwrap();
+        let (x, y) = (2.9625, 2.5125);
+        // Paper: 0.1 m < r_F = 0.12 m, infinite at any heading.
+        assert_eq!(paper.foot_cost_at(x, y), Cost::Infinite);
+        assert_eq!(paper.foot_cost_at_heading(x, y, 0.0), Cost::Infinite);
+        // Wheel pair (radius 0.08 m, wheel centres 0.1 m apart): facing the edge, each
+        // wheel is 0.1 m from the marked cells, clear. Facing along it, the wheel
+        // centres sit at x ± 0.05 m: the front one 0.05 m < 0.08 m from them.
+        assert!(wp.foot_cost_at_heading(x, y, 0.0).is_finite());
+        assert!(wp.foot_cost_at_heading(x, y, std::f64::consts::PI).is_finite());
+        assert_eq!(wp.foot_cost_at_heading(x, y, std::f64::consts::FRAC_PI_2), Cost::Infinite);
+        assert!(wp.foot_cost_at(x, y).is_finite(), "the most favourable heading");
+        // The pose facing the edge stands; the same pose driving sideways or turning on
+        // the spot would steer the front pairs across the edge.
+        let d = wp.pose_cost_detail(&CENTRE, &wp.neutral_feet(&CENTRE), &[0.27; 4]);
+        assert!(d.feet[0].is_finite() && d.feet[1].is_finite(), "{d:?}");
+        assert_eq!(paper.driving_pose_cost(&CENTRE), Cost::Infinite);
+        assert!(wp.steered_feet_fit(&CENTRE, Some(0.0)));
+        assert!(wp.steered_feet_fit(&CENTRE, Some(std::f64::consts::PI)));
+        assert!(!wp.steered_feet_fit(&CENTRE, Some(std::f64::consts::FRAC_PI_2)));
+        assert!(!wp.steered_feet_fit(&CENTRE, None), "front-left tangent at 114°");
+        // The paper's model does not depend on the steering.
+        assert!(paper.steered_feet_fit(&CENTRE, Some(std::f64::consts::FRAC_PI_2)));
+        assert!(paper.steered_feet_fit(&CENTRE, None));
     }
 
     #[test]
