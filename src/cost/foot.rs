@@ -72,6 +72,13 @@ pub struct WheelPair {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct HeadingBin(usize);
 
+impl HeadingBin {
+    /// The bin's index (0 for every heading in the paper's model).
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
+
 /// Most heading bins a wheel-pair layer keeps (one bit each per cell).
 const MAX_BINS: usize = 64;
 
@@ -323,6 +330,17 @@ impl FootCostLayer {
                     h.finite[k]
                 }
             }
+        }
+    }
+
+    /// The heading bins at which cell `k` (row-major) has a finite C_F, as bits (every
+    /// bit or none for the paper's model).
+    #[inline]
+    pub(crate) fn finite_bins(&self, k: usize) -> u64 {
+        match &self.headings {
+            None if self.values[k].is_finite() => u64::MAX,
+            None => 0,
+            Some(h) => !(h.infinite[k] | h.unknown[k]),
         }
     }
 

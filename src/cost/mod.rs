@@ -320,18 +320,38 @@ impl CostMaps {
     /// the paper's foot model, whose cost does not depend on the heading: the wheel-pair
     /// model's pose costs assume straight wheels, and a drive steers them.
     pub fn steered_feet_fit(&self, pose: &Pose2, direction: Option<f64>) -> bool {
+        self.steered_feet_fit_mask(pose, &[direction]) & 1 == 1
+    }
+
+    /// [`Self::steered_feet_fit`] for several steerings at once: bit k for
+    /// `directions[k]` (at most 32; all ones with the paper's model). One look-up per
+    /// foot serves every direction.
+    pub fn steered_feet_fit_mask(&self, pose: &Pose2, directions: &[Option<f64>]) -> u32 {
         if !self.foot_oriented {
-            return true;
+            return u32::MAX;
         }
         let feet = self.neutral_feet(pose);
-        feet.iter().zip(&self.neutral_footprint).all(|(f, n)| {
-            let heading = direction.unwrap_or(pose.theta + n[0].atan2(-n[1]));
-            let bin = self.foot.heading_bin(heading);
+        // Per foot, the heading bins at which it has a finite C_F (none off the map).
+        let fits = feet.map(|f| {
             self.heights
                 .cell_of(f[0], f[1])
                 .and_then(|(i, j)| self.heights.index(i, j))
-                .is_some_and(|k| self.foot.raw_at(k, bin).is_finite())
-        })
+                .map_or(0, |k| self.foot.finite_bins(k))
+        });
+        let mut mask = 0;
+        for (bit, d) in directions.iter().enumerate().take(32) {
+            let ok = fits.iter().zip(&self.neutral_footprint).all(|(&fit, n)| {
+                let heading = d.unwrap_or_else(|| pose.theta + n[0].atan2(-n[1]));
+                fit >> self.foot.heading_bin(heading).index() & 1 == 1
+            });
+            mask |= u32::from(ok) << bit;
+        }
+        mask
+    }
+
+    /// Whether C_F depends on the foot heading (the wheel-pair foot model).
+    pub fn foot_heading_dependent(&self) -> bool {
+        self.foot_oriented
     }
 
     /// World positions of the neutral footprint's feet (FL, FR, RL, RR) at `pose`.
@@ -712,6 +732,10 @@ mod tests {
         assert!(wp.steered_feet_fit(&CENTRE, Some(std::f64::consts::PI)));
         assert!(!wp.steered_feet_fit(&CENTRE, Some(std::f64::consts::FRAC_PI_2)));
         assert!(!wp.steered_feet_fit(&CENTRE, None), "front-left tangent at 114°");
+        // All at once, as the driving graph memoises them: bit k for direction k.
+        let dirs = [Some(0.0), Some(std::f64::consts::FRAC_PI_2), None, Some(-3.0)];
+        assert_eq!(wp.steered_feet_fit_mask(&CENTRE, &dirs), 0b1001);
+        assert_eq!(paper.steered_feet_fit_mask(&CENTRE, &dirs), u32::MAX);
         // The paper's model does not depend on the steering.
         assert!(paper.steered_feet_fit(&CENTRE, Some(std::f64::consts::FRAC_PI_2)));
         assert!(paper.steered_feet_fit(&CENTRE, None));

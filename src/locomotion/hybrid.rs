@@ -328,8 +328,12 @@ impl PoseCostSource for FeasibleDriving<'_> {
         self.check.lattice_pose(self.maps, pose).ok().map(|()| cost)
     }
 
-    fn steered_fit(&self, pose: &Pose2, direction: Option<f64>) -> bool {
-        self.maps.steered_feet_fit(pose, direction)
+    fn steering_matters(&self) -> bool {
+        self.maps.foot_heading_dependent()
+    }
+
+    fn steered_fit_mask(&self, pose: &Pose2, directions: &[Option<f64>]) -> u32 {
+        self.maps.steered_feet_fit_mask(pose, directions)
     }
 }
 
