@@ -21,7 +21,8 @@ pub struct Params {
     /// Foot cost weight k1 (eq. 1).
     pub k1: f64,
     /// Foot radius r_F (eq. 2): a height difference above `max_foot_height_diff_m` closer
-    /// than this makes the foot cost infinite.
+    /// than this makes the foot cost infinite. Used by `foot_model = "paper"` only; the
+    /// wheel-pair model takes the wheels' footprint from the robot model instead.
     pub r_f_m: f64,
     /// Neighbourhood radius r_N (eq. 2) over which height differences are accumulated.
     pub r_n_m: f64,
