@@ -220,6 +220,21 @@ pub struct PlannerArgs {
     /// ramp_detour and ramp_far).
     #[arg(long, allow_negative_numbers = true)]
     pub step_cost_factor: Option<f64>,
+    /// Foot model of the foot cost (default: the scenario's `[params] foot_model`,
+    /// `paper`): `paper`, the paper's disc of radius r_F (eq. 2), or `wheel_pair`, the
+    /// wheel pair's contact footprint at the foot's heading.
+    #[arg(long, value_enum)]
+    pub foot_model: Option<FootModelArg>,
+}
+
+/// `--foot-model` values (`Params::foot_model`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FootModelArg {
+    /// The paper's r_F disc (eq. 2).
+    Paper,
+    /// The wheel pair's footprint at the foot's heading.
+    #[value(name = "wheel_pair", alias = "wheel-pair")]
+    WheelPair,
 }
 
 impl PlannerArgs {
@@ -234,6 +249,10 @@ impl PlannerArgs {
             final_epsilon: self.final_epsilon,
             k12: self.k12,
             step_cost_factor: self.step_cost_factor,
+            foot_model: self.foot_model.map(|m| match m {
+                FootModelArg::Paper => crate::params::FootModel::Paper,
+                FootModelArg::WheelPair => crate::params::FootModel::WheelPair,
+            }),
             ..jobs::plan::PlanOptions::default()
         }
     }

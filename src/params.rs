@@ -21,12 +21,18 @@ pub struct Params {
     /// Foot cost weight k1 (eq. 1).
     pub k1: f64,
     /// Foot radius r_F (eq. 2): a height difference above `max_foot_height_diff_m` closer
-    /// than this makes the foot cost infinite.
+    /// than this makes the foot cost infinite. Used by `foot_model = "paper"` only; the
+    /// wheel-pair model takes the wheels' footprint from the robot model instead.
     pub r_f_m: f64,
     /// Neighbourhood radius r_N (eq. 2) over which height differences are accumulated.
     pub r_n_m: f64,
     /// Untraversable height difference for a wheel (eq. 2): 0.05 m.
     pub max_foot_height_diff_m: f64,
+    /// Which ground a foot must find free of height differences above
+    /// `max_foot_height_diff_m` (eq. 2, first case): the paper's disc of radius `r_f_m`
+    /// (the default) or the wheel pair's own contact footprint at the foot's heading
+    /// (see [`FootModel`] and `cost::foot`).
+    pub foot_model: FootModel,
 
     /// Body cost weight k2 on missing clearance under the base (eq. 3).
     pub k2: f64,
@@ -126,6 +132,7 @@ impl Default for Params {
             r_f_m: 0.12,
             r_n_m: 0.3,
             max_foot_height_diff_m: 0.05,
+            foot_model: FootModel::Paper,
             k2: 1.0,
             k3: 0.5,
             base_circle_radius_m: 0.25,
@@ -153,6 +160,32 @@ impl Default for Params {
             step_support_margin_m: 0.055,
             arastar_initial_epsilon: 3.0,
             arastar_epsilon_decay: 0.5,
+        }
+    }
+}
+
+/// The foot model of the foot cost's infinite case (eq. 2, first case), written
+/// `foot_model = "paper"` or `foot_model = "wheel_pair"` in a scenario's `[params]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FootModel {
+    /// The paper's (eq. 2): infinite when a height difference above the limit lies
+    /// closer than r_F to the cell, whatever the foot's heading.
+    #[default]
+    Paper,
+    /// The wheel pair's contact footprint: the two wheels of the model (radius and
+    /// spacing read from the model file), side by side across the foot's heading, which
+    /// is the base heading. Infinite when a height difference above the limit lies under
+    /// a wheel at that heading; the r_N sum (eq. 1) is the paper's.
+    WheelPair,
+}
+
+impl FootModel {
+    /// The name used in scenario files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            FootModel::Paper => "paper",
+            FootModel::WheelPair => "wheel_pair",
         }
     }
 }

@@ -155,6 +155,32 @@ fn bad_planner_option_names_the_parameter() {
 }
 
 #[test]
+fn foot_model_is_checked_in_the_file_and_on_the_command_line() {
+    expect_bad_input(
+        "bad_foot_model",
+        &format!("{GOOD}\n[params]\nfoot_model = \"wheels\"\n"),
+        &["foot_model", "`paper`", "`wheel_pair`"],
+    );
+    let scenario = common::root().join("scenarios/flat.toml");
+    let out = momaro(&["plan", scenario.to_str().unwrap(), "--foot-model", "wheels"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("wheel_pair") && !stderr.contains("panicked"), "{stderr}");
+    let out = momaro(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--foot-model",
+        "wheel_pair",
+        "--final-epsilon",
+        "3",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    assert_eq!(v["foot_model"], "wheel_pair");
+}
+
+#[test]
 fn json_summary_has_the_documented_fields() {
     let scenario = common::root().join("scenarios/flat.toml");
     let out = momaro(&["sim", scenario.to_str().unwrap(), "--duration", "1", "--json"]);

@@ -42,7 +42,7 @@ fn expand(
     path: &[PathElement],
 ) -> Result<DetailedPath, MotionError> {
     let robot = sim.robot().clone();
-    let prep = plan::prepare(s, &robot, None, None).expect("maps");
+    let prep = plan::prepare(s, &robot, None, None, None).expect("maps");
     let options = MotionOptions::from_params(&prep.params);
     expand_path(path, &robot, &prep.maps, sim, &options)
 }
@@ -159,7 +159,7 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
     // The path up to its first step, with a margin no step can keep, fails at that step,
     // naming it and its leg.
     let robot = sim.robot().clone();
-    let prep = plan::prepare(&s, &robot, None, None).expect("maps");
+    let prep = plan::prepare(&s, &robot, None, None, None).expect("maps");
     // 15 cm: the four-wheel postures before it keep more (about 0.3 m), no three-wheel
     // posture can (its best: 0.1 m).
     let options = MotionOptions { min_margin_m: 0.15, ..MotionOptions::from_params(&prep.params) };
@@ -209,7 +209,7 @@ height = 0.1
     let s = Scenario::parse(text, Path::new("blocked_wheel.toml")).expect("scenario");
     let mut sim = sim();
     let robot = sim.robot().clone();
-    let prep = plan::prepare(&s, &robot, None, None).expect("maps");
+    let prep = plan::prepare(&s, &robot, None, None, None).expect("maps");
     let neutral = robot.neutral_footprint();
     let start = PathElement {
         kind: PathKind::Start,

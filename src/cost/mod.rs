@@ -21,11 +21,11 @@ pub mod foot;
 pub mod pose;
 
 pub use body::{BodyGeometry, DiscMaxLayer};
-pub use foot::{FootCostLayer, height_differences};
+pub use foot::{FootCostLayer, HeadingBin, WheelPair, height_differences};
 pub use pose::{PoseCost, PoseWeights, combine};
 
 use crate::geometry::Pose2;
-use crate::params::{InvalidParam, Params};
+use crate::params::{FootModel, InvalidParam, Params};
 use crate::robot::RobotDescription;
 use crate::terrain::HeightMap;
 
@@ -98,6 +98,8 @@ pub struct CostMaps {
     /// Per cell `[C_F raw, height raw]` (`NaN` unknown, `+∞` infinite C_F): a foot's two
     /// look-ups share one cache line, which matters for scattered queries.
     foot_cells: Vec<[f64; 2]>,
+    /// Whether C_F depends on the foot heading (the wheel-pair foot model).
+    foot_oriented: bool,
     disc_max: DiscMaxLayer,
     /// Heights dilated by two cells (5 cm): the terrain a leg point must clear.
     leg_terrain: HeightMap,
@@ -141,11 +143,28 @@ impl CostMaps {
             k2: params.k2,
             k3: params.k3,
         };
-        let foot = FootCostLayer::compute(map, params);
+        let foot = match params.foot_model {
+            FootModel::Paper => FootCostLayer::compute(map, params),
+            FootModel::WheelPair => {
+                let positive = |field: &'static str, value: f64| {
+                    if value.is_finite() && value > 0.0 {
+                        Ok(value)
+                    } else {
+                        Err(CostError::BadRobot { field, value })
+                    }
+                };
+                let wheels = WheelPair {
+                    radius: positive("wheel_radius", robot.wheel_radius)?,
+                    track: check("wheel_track", robot.wheel_track)?.abs(),
+                };
+                FootCostLayer::wheel_pair(map, params, wheels)
+            }
+        };
         let foot_cells =
             map.as_slice().iter().enumerate().map(|(k, &h)| [foot.raw(k), h]).collect();
         Ok(Self {
             heights: map.clone(),
+            foot_oriented: params.foot_model != FootModel::Paper,
             foot,
             foot_cells,
             disc_max: DiscMaxLayer::compute(map, params.base_circle_radius_m),
@@ -194,7 +213,10 @@ impl CostMaps {
         self.heights.height_at_cell(x, y)
     }
 
-    /// C_F (eq. 1) of the cell containing (x, y); `Unknown` off the map.
+    /// C_F (eq. 1) of the cell containing (x, y); `Unknown` off the map. With the
+    /// wheel-pair foot model, at the most favourable heading (see
+    /// [`Self::foot_cost_cell`]); a foot of known heading uses
+    /// [`Self::foot_cost_at_heading`].
     #[inline]
     pub fn foot_cost_at(&self, x: f64, y: f64) -> Cost {
         match self.heights.cell_of(x, y) {
@@ -203,16 +225,64 @@ impl CostMaps {
         }
     }
 
-    /// C_F (eq. 1) of cell (i, j); `Unknown` off the map.
+    /// C_F (eq. 1–2) of the cell containing (x, y) for a foot facing `theta` (rad; a
+    /// foot faces its base's heading); `Unknown` off the map. Equal to
+    /// [`Self::foot_cost_at`] with the paper's foot model.
+    #[inline]
+    pub fn foot_cost_at_heading(&self, x: f64, y: f64, theta: f64) -> Cost {
+        match self.heights.cell_of(x, y) {
+            Some((i, j)) => self.foot.get_at(i, j, self.foot.heading_bin(theta)),
+            None => Cost::Unknown,
+        }
+    }
+
+    /// C_F (eq. 1) of cell (i, j); `Unknown` off the map. With the wheel-pair foot model
+    /// (`Params::foot_model`), the cost at the cell's most favourable foot heading: a
+    /// lower bound for relaxations and images; poses use [`Self::foot_cost_cell_at`].
     #[inline]
     pub fn foot_cost_cell(&self, i: usize, j: usize) -> Cost {
         self.foot.get(i, j)
+    }
+
+    /// The foot-cost layer's bin for a foot heading `theta` (rad); a foot's heading is
+    /// its base's (the wheels stand straight while stepping and driving forward).
+    #[inline]
+    pub fn foot_heading_bin(&self, theta: f64) -> HeadingBin {
+        self.foot.heading_bin(theta)
+    }
+
+    /// C_F (eq. 1–2) of cell (i, j) for a foot at heading bin `bin`; `Unknown` off the
+    /// map. Equal to [`Self::foot_cost_cell`] with the paper's foot model.
+    #[inline]
+    pub fn foot_cost_cell_at(&self, i: usize, j: usize, bin: HeadingBin) -> Cost {
+        self.foot.get_at(i, j, bin)
+    }
+
+    /// Whether cell (i, j) has infinite C_F at some foot heading (with the paper's
+    /// model: whether it is infinite); `false` off the map. A superset of every
+    /// heading's infinite cells, for pre-filters.
+    #[inline]
+    pub fn foot_cost_infinite_at_some_heading(&self, i: usize, j: usize) -> bool {
+        let (nx, ny) = self.heights.dims();
+        i < nx && j < ny && self.foot.infinite_at_some_heading(j * nx + i)
     }
 
     /// Whether any cell whose centre is closer than `radius` to (x, y) has infinite C_F:
     /// the paper's first step criterion (Sec. V, "close to an obstacle"). Scans the disc
     /// (about 50 cells for 0.1 m); no allocation.
     pub fn infinite_foot_cost_within(&self, x: f64, y: f64, radius: f64) -> bool {
+        self.infinite_foot_cost_within_at(x, y, radius, None)
+    }
+
+    /// As [`Self::infinite_foot_cost_within`], with C_F at heading bin `bin` (the most
+    /// favourable heading's for `None`).
+    pub fn infinite_foot_cost_within_at(
+        &self,
+        x: f64,
+        y: f64,
+        radius: f64,
+        bin: Option<HeadingBin>,
+    ) -> bool {
         let res = self.heights.resolution();
         let o = self.heights.origin();
         let (nx, ny) = self.heights.dims();
@@ -230,12 +300,58 @@ impl CostMaps {
         for j in j0 as usize..=j1 as usize {
             for i in i0 as usize..=i1 as usize {
                 let c = self.heights.cell_center(i, j);
-                if (c[0] - x).hypot(c[1] - y) < radius && self.foot.raw(j * nx + i).is_infinite() {
+                let k = j * nx + i;
+                let v = match bin {
+                    Some(b) => self.foot.raw_at(k, b),
+                    None => self.foot.raw(k),
+                };
+                if (c[0] - x).hypot(c[1] - y) < radius && v.is_infinite() {
                     return true;
                 }
             }
         }
         false
+    }
+
+    /// Whether every neutral foot at `pose` has a finite C_F with its wheel pair steered
+    /// for a drive: to the world direction `direction` of a straight move, or, for `None`
+    /// (turning on the spot), across the line to the base centre (the steering of
+    /// `control::wheels`, whose pair rolls along the foot's velocity). Always true with
+    /// the paper's foot model, whose cost does not depend on the heading: the wheel-pair
+    /// model's pose costs assume straight wheels, and a drive steers them.
+    pub fn steered_feet_fit(&self, pose: &Pose2, direction: Option<f64>) -> bool {
+        self.steered_feet_fit_mask(pose, &[direction]) & 1 == 1
+    }
+
+    /// [`Self::steered_feet_fit`] for several steerings at once: bit k for
+    /// `directions[k]` (at most 32; all ones with the paper's model). One look-up per
+    /// foot serves every direction.
+    pub fn steered_feet_fit_mask(&self, pose: &Pose2, directions: &[Option<f64>]) -> u32 {
+        if !self.foot_oriented {
+            return u32::MAX;
+        }
+        let feet = self.neutral_feet(pose);
+        // Per foot, the heading bins at which it has a finite C_F (none off the map).
+        let fits = feet.map(|f| {
+            self.heights
+                .cell_of(f[0], f[1])
+                .and_then(|(i, j)| self.heights.index(i, j))
+                .map_or(0, |k| self.foot.finite_bins(k))
+        });
+        let mut mask = 0;
+        for (bit, d) in directions.iter().enumerate().take(32) {
+            let ok = fits.iter().zip(&self.neutral_footprint).all(|(&fit, n)| {
+                let heading = d.unwrap_or_else(|| pose.theta + n[0].atan2(-n[1]));
+                fit >> self.foot.heading_bin(heading).index() & 1 == 1
+            });
+            mask |= u32::from(ok) << bit;
+        }
+        mask
+    }
+
+    /// Whether C_F depends on the foot heading (the wheel-pair foot model).
+    pub fn foot_heading_dependent(&self) -> bool {
+        self.foot_oriented
     }
 
     /// World positions of the neutral footprint's feet (FL, FR, RL, RR) at `pose`.
@@ -317,7 +433,10 @@ impl CostMaps {
         feet: &[[f64; 2]; 4],
         leg_heights: &[f64; 4],
     ) -> PoseCost {
-        // One cell look-up per foot serves both its C_F and its ground height.
+        // One cell look-up per foot serves both its C_F and its ground height. The feet's
+        // heading is the base's: the neutral footprint and the step stances stand with
+        // straight wheels.
+        let bin = self.foot.heading_bin(pose.theta);
         let mut feet_cost = [Cost::Unknown; 4];
         let mut ground = [0.0; 4];
         let mut ground_known = true;
@@ -329,6 +448,7 @@ impl CostMaps {
             match cell {
                 Some(idx) => {
                     let [cf, h] = self.foot_cells[idx];
+                    let cf = if self.foot_oriented { self.foot.raw_at(idx, bin) } else { cf };
                     feet_cost[k] = Cost::from_raw(cf);
                     if h.is_nan() {
                         ground_known = false;
@@ -586,6 +706,46 @@ mod tests {
         assert!(finite(d.feet[0]) > 1.0 && d.feet[2] == Cost::Finite(1.0), "{d:?}");
         assert!(finite(d.total) > 1.0);
         assert!(!low.infinite_foot_cost_within(2.9625, 2.5125, 0.3));
+    }
+
+    #[test]
+    fn wheel_pair_fits_a_foot_facing_an_edge_the_paper_disc_does_not() {
+        // A 0.17 m step whose edge lies at x = 3.075: ΔH marks cells 122 (centre
+        // 3.0625) and 123. The front feet stand on cell 118 (centre 2.9625), 4 cells =
+        // 0.1 m from the nearest marked cell.
+        let prims =
+            [Primitive::Box { center: [4.025, 2.5], size: [1.9, 5.0], height: 0.17, yaw_deg: 0.0 }];
+        let m = rasterise(&prims, [0.0, 0.0], [5.0, 5.0], RES).unwrap();
+        let paper = CostMaps::build(&m, &robot(), &Params::default()).unwrap();
+        let wp_params = Params { foot_model: FootModel::WheelPair, ..Params::default() };
+        let wp = CostMaps::build(&m, &robot(), &wp_params).unwrap();
+        let (x, y) = (2.9625, 2.5125);
+        // Paper: 0.1 m < r_F = 0.12 m, infinite at any heading.
+        assert_eq!(paper.foot_cost_at(x, y), Cost::Infinite);
+        assert_eq!(paper.foot_cost_at_heading(x, y, 0.0), Cost::Infinite);
+        // Wheel pair (radius 0.08 m, wheel centres 0.1 m apart): facing the edge, each
+        // wheel is 0.1 m from the marked cells, clear. Facing along it, the wheel
+        // centres sit at x ± 0.05 m: the front one 0.05 m < 0.08 m from them.
+        assert!(wp.foot_cost_at_heading(x, y, 0.0).is_finite());
+        assert!(wp.foot_cost_at_heading(x, y, std::f64::consts::PI).is_finite());
+        assert_eq!(wp.foot_cost_at_heading(x, y, std::f64::consts::FRAC_PI_2), Cost::Infinite);
+        assert!(wp.foot_cost_at(x, y).is_finite(), "the most favourable heading");
+        // The pose facing the edge stands; the same pose driving sideways or turning on
+        // the spot would steer the front pairs across the edge.
+        let d = wp.pose_cost_detail(&CENTRE, &wp.neutral_feet(&CENTRE), &[0.27; 4]);
+        assert!(d.feet[0].is_finite() && d.feet[1].is_finite(), "{d:?}");
+        assert_eq!(paper.driving_pose_cost(&CENTRE), Cost::Infinite);
+        assert!(wp.steered_feet_fit(&CENTRE, Some(0.0)));
+        assert!(wp.steered_feet_fit(&CENTRE, Some(std::f64::consts::PI)));
+        assert!(!wp.steered_feet_fit(&CENTRE, Some(std::f64::consts::FRAC_PI_2)));
+        assert!(!wp.steered_feet_fit(&CENTRE, None), "front-left tangent at 114°");
+        // All at once, as the driving graph memoises them: bit k for direction k.
+        let dirs = [Some(0.0), Some(std::f64::consts::FRAC_PI_2), None, Some(-3.0)];
+        assert_eq!(wp.steered_feet_fit_mask(&CENTRE, &dirs), 0b1001);
+        assert_eq!(paper.steered_feet_fit_mask(&CENTRE, &dirs), u32::MAX);
+        // The paper's model does not depend on the steering.
+        assert!(paper.steered_feet_fit(&CENTRE, Some(std::f64::consts::FRAC_PI_2)));
+        assert!(paper.steered_feet_fit(&CENTRE, None));
     }
 
     #[test]

@@ -57,7 +57,13 @@ pub fn expand(
     plan: &PlanSummary,
 ) -> Result<DetailedPath, DetailedJobError> {
     let robot = sim.robot().clone();
-    let prep = plan::prepare(scenario, &robot, Some(plan.k12), Some(plan.step_cost_factor))?;
+    let prep = plan::prepare(
+        scenario,
+        &robot,
+        Some(plan.k12),
+        Some(plan.step_cost_factor),
+        Some(plan.foot_model),
+    )?;
     let options = MotionOptions::from_params(&prep.params);
     expand_path(&plan.path, &robot, &prep.maps, sim, &options)
         .map_err(|source| DetailedJobError::Motion { scenario: scenario.name.clone(), source })

@@ -128,7 +128,7 @@ pub fn checked_case(
         let text = case.to_toml();
         let path = dir.join(case.file_name());
         match Scenario::parse(&text, &path) {
-            Ok(scenario) => match plan::prepare(&scenario, robot, None, None) {
+            Ok(scenario) => match plan::prepare(&scenario, robot, None, None, None) {
                 Ok(_) => return Ok((case, text)),
                 Err(e) => reason = format!("draw {}: {e}", case.draw),
             },

@@ -25,7 +25,7 @@ use crate::locomotion::{
     Algorithm, DrivingGoal, HybridConfig, HybridGraph, LatticeError, LatticeState, ManoeuvreKind,
     Neighbourhood, PoseKey, StepCost,
 };
-use crate::params::{InvalidParam, Params};
+use crate::params::{FootModel, InvalidParam, Params};
 use crate::planner::{
     Cost, Hooks, SearchError, SearchParams, SearchResult, Termination, arastar_with_hooks,
     astar_with_hooks,
@@ -55,6 +55,8 @@ pub struct PlanOptions {
     pub k12: Option<f64>,
     /// Step-related cost factor; default the scenario's (`Params::step_cost_factor`).
     pub step_cost_factor: Option<f64>,
+    /// Foot model of the foot cost; default the scenario's (`Params::foot_model`).
+    pub foot_model: Option<FootModel>,
     /// Driving neighbourhood; default N16 for A*, N20 for ARA* (Sec. VII-B).
     pub neighbourhood: Option<Neighbourhood>,
     /// Edges to leave out: manoeuvres the motion generator could not expand in an
@@ -71,6 +73,7 @@ impl Default for PlanOptions {
             final_epsilon: None,
             k12: None,
             step_cost_factor: None,
+            foot_model: None,
             neighbourhood: None,
             forbidden: Vec::new(),
         }
@@ -287,6 +290,8 @@ pub struct PlanSummary {
     pub footprints: usize,
     /// The step-related factor used.
     pub step_cost_factor: f64,
+    /// The foot model used (`paper` or `wheel_pair`).
+    pub foot_model: FootModel,
     /// k12 used.
     pub k12: f64,
     /// The grid.
@@ -346,6 +351,7 @@ pub fn prepare(
     robot: &RobotDescription,
     k12: Option<f64>,
     step_cost_factor: Option<f64>,
+    foot_model: Option<FootModel>,
 ) -> Result<Prepared, PlanJobError> {
     let t0 = Instant::now();
     let file = || scenario.path.clone();
@@ -355,6 +361,9 @@ pub fn prepare(
     }
     if let Some(f) = step_cost_factor {
         params.step_cost_factor = f;
+    }
+    if let Some(m) = foot_model {
+        params.foot_model = m;
     }
     params.validate().map_err(|source| PlanJobError::Params { scenario: file(), source })?;
     let (maps, lattice) = build_maps(scenario, robot, &params)?;
@@ -614,7 +623,7 @@ pub fn run(
     }
     let t0 = Instant::now();
     let file = || scenario.path.clone();
-    let prep = prepare(scenario, robot, opts.k12, opts.step_cost_factor)?;
+    let prep = prepare(scenario, robot, opts.k12, opts.step_cost_factor, opts.foot_model)?;
     let neighbourhood = opts.neighbourhood.unwrap_or_else(|| default_neighbourhood(opts.algorithm));
     let lattice_err = |source| PlanJobError::Lattice { scenario: file(), source };
     let mut graph = prep.graph(robot, neighbourhood, prep.params.k12).map_err(lattice_err)?;
@@ -680,6 +689,7 @@ pub fn run(
         states: result.states,
         footprints: graph.footprint_count(),
         step_cost_factor: prep.params.step_cost_factor,
+        foot_model: prep.params.foot_model,
         k12: prep.params.k12,
         map: prep.map_info(),
         keys,
@@ -846,7 +856,7 @@ pub fn bench(
         return Err(bad("repeats", "0 must be at least 1"));
     }
     let file = || scenario.path.clone();
-    let prep = prepare(scenario, robot, opts.k12, None)?;
+    let prep = prepare(scenario, robot, opts.k12, None, None)?;
     let k12 = prep.params.k12;
     let run_one =
         |algorithm, n, limit| -> Result<(SearchResult<LatticeState>, f64), PlanJobError> {

@@ -488,7 +488,13 @@ pub fn expand_mission(
     end: usize,
 ) -> Result<DetailedPath, RunJobError> {
     let robot = sim.robot().clone();
-    let prep = plan::prepare(scenario, &robot, Some(plan.k12), Some(plan.step_cost_factor))?;
+    let prep = plan::prepare(
+        scenario,
+        &robot,
+        Some(plan.k12),
+        Some(plan.step_cost_factor),
+        Some(plan.foot_model),
+    )?;
     let options = MotionOptions::from_params(&prep.params);
     let end = end.min(plan.path.len());
     expand_path(&plan.path[..end], &robot, &prep.maps, sim, &options)

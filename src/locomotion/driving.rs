@@ -12,7 +12,11 @@
 //!   wheel travel would cost as a drive).
 //!
 //! Pose costs below 1 are raised to 1 (the paper's costs are ≥ 1; the heuristic relies
-//! on it); untraversable or unknown poses have no edges into them. Only the two end
+//! on it); untraversable or unknown poses have no edges into them. A foot model that
+//! depends on the foot heading (`Params::foot_model = wheel_pair`) prices poses with
+//! straight wheels, while a drive steers every pair along its velocity: such a move or
+//! turn also needs both end poses' feet to fit with the pairs steered so
+//! ([`PoseCostSource::steered_fit`]); the paper's model always fits. Only the two end
 //! poses of a move are checked: a two-cell move could hop a one-cell-wide untraversable
 //! line, which the cost client never produces (infinite foot costs are dilated by
 //! r_F = 0.12 m, about five cells).
@@ -45,11 +49,33 @@ pub trait PoseCostSource {
     /// Pose cost C (eq. 4) of the neutral footprint at `pose` with driving leg heights;
     /// `None` where the pose is untraversable or unknown.
     fn driving_cost(&self, pose: &Pose2) -> Option<f64>;
+
+    /// Whether [`Self::steered_fit_mask`] can clear a bit (a foot model that depends on
+    /// the heading): the graph then memoises the masks per pose. Default: no.
+    fn steering_matters(&self) -> bool {
+        false
+    }
+
+    /// Bit k set when the wheel pairs at `pose` fit the terrain steered for a drive in
+    /// world direction `directions[k]` (`None`: a turn on the spot). The pose cost
+    /// assumes straight wheels; a foot model that depends on the heading checks the
+    /// steering here (`CostMaps::steered_feet_fit_mask`). Default: they all fit.
+    fn steered_fit_mask(&self, _pose: &Pose2, _directions: &[Option<f64>]) -> u32 {
+        u32::MAX
+    }
 }
 
 impl PoseCostSource for &crate::cost::CostMaps {
     fn driving_cost(&self, pose: &Pose2) -> Option<f64> {
         self.driving_pose_cost(pose).finite()
+    }
+
+    fn steering_matters(&self) -> bool {
+        self.foot_heading_dependent()
+    }
+
+    fn steered_fit_mask(&self, pose: &Pose2, directions: &[Option<f64>]) -> u32 {
+        self.steered_feet_fit_mask(pose, directions)
     }
 }
 
@@ -124,7 +150,15 @@ pub struct DrivingGraph<C: PoseCostSource> {
     cache: Vec<f32>,
     /// Number of pose costs computed.
     computed: usize,
+    /// The moves' world directions, then `None` for the turns (bit order of `steer`).
+    directions: Vec<Option<f64>>,
+    /// Steering masks per lattice pose, indexed as `cache` (bit k: `directions[k]` fits;
+    /// bit 31: computed), only when [`PoseCostSource::steering_matters`]; else empty.
+    steer: Vec<u32>,
 }
+
+/// Bit of a computed steering mask.
+const STEER_COMPUTED: u32 = 1 << 31;
 
 /// An edge cost in fixed point: rounded up, ignoring relative float noise below 10⁻¹².
 #[inline]
@@ -151,6 +185,12 @@ impl<C: PoseCostSource> DrivingGraph<C> {
                 move_weight.push(m.cells * lattice.resolution * k_theta);
             }
         }
+        let poses =
+            usize::from(lattice.nx) * usize::from(lattice.ny) * usize::from(lattice.orientations);
+        // Masks have 31 usable bits: at most 20 moves and the turns.
+        let steer =
+            if costs.steering_matters() && moves.len() < 31 { vec![0; poses] } else { Vec::new() };
+        let directions = moves.iter().map(|m| Some(m.direction)).chain([None]).collect();
         Self {
             costs,
             lattice,
@@ -159,14 +199,29 @@ impl<C: PoseCostSource> DrivingGraph<C> {
             moves,
             move_weight,
             turn_length: config.turn_radius_m * lattice.orientation_step(),
-            cache: vec![
-                0.0;
-                usize::from(lattice.nx)
-                    * usize::from(lattice.ny)
-                    * usize::from(lattice.orientations)
-            ],
+            cache: vec![0.0; poses],
             computed: 0,
+            directions,
+            steer,
         }
+    }
+
+    /// The steering mask of `s` (see `steer`); all ones when steering does not matter.
+    /// `s` must be on the lattice (as `pose_cost` has checked).
+    #[inline]
+    fn steer_mask(&mut self, s: LatticeState) -> u32 {
+        if self.steer.is_empty() {
+            return u32::MAX;
+        }
+        let cell = s.j as usize * usize::from(self.lattice.nx) + s.i as usize;
+        let idx = cell * usize::from(self.lattice.orientations) + usize::from(s.theta);
+        let mut m = self.steer[idx];
+        if m & STEER_COMPUTED == 0 {
+            m = self.costs.steered_fit_mask(&self.lattice.pose(s), &self.directions)
+                | STEER_COMPUTED;
+            self.steer[idx] = m;
+        }
+        m
     }
 
     /// The lattice.
@@ -241,6 +296,7 @@ impl<C: PoseCostSource> SearchGraph for DrivingGraph<C> {
             return;
         }
         let Some(cs) = self.pose_cost(s) else { return };
+        let steer_s = self.steer_mask(s);
         let row = usize::from(s.theta) * self.moves.len();
         for idx in 0..self.moves.len() {
             let m = self.moves[idx];
@@ -256,7 +312,9 @@ impl<C: PoseCostSource> SearchGraph for DrivingGraph<C> {
             {
                 continue;
             }
-            if let Some(ct) = self.pose_cost(t) {
+            if let Some(ct) = self.pose_cost(t)
+                && (steer_s & self.steer_mask(t)) >> idx & 1 == 1
+            {
                 let w = self.move_weight[row + idx];
                 out.push((t, edge_cost(w * 0.5 * (cs + ct))));
             }
@@ -271,7 +329,10 @@ impl<C: PoseCostSource> SearchGraph for DrivingGraph<C> {
         };
         for &theta in turns {
             let t = LatticeState { theta, ..s };
-            if let Some(ct) = self.pose_cost(t) {
+            let turn_bit = self.moves.len();
+            if let Some(ct) = self.pose_cost(t)
+                && (steer_s & self.steer_mask(t)) >> turn_bit & 1 == 1
+            {
                 out.push((t, edge_cost(self.turn_length * 0.5 * (cs + ct))));
             }
         }

@@ -100,7 +100,7 @@ use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{StepBound, StepBoundParams};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use super::reachability::BaseRegions;
-use crate::cost::{Cost as CostValue, CostMaps};
+use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
 use crate::motion::expand::{self, MotionOptions};
@@ -384,6 +384,14 @@ impl PoseCostSource for FeasibleDriving<'_> {
         let cost = self.maps.driving_pose_cost(pose).finite()?;
         self.check.lattice_pose(self.maps, pose).ok().map(|()| cost)
     }
+
+    fn steering_matters(&self) -> bool {
+        self.maps.foot_heading_dependent()
+    }
+
+    fn steered_fit_mask(&self, pose: &Pose2, directions: &[Option<f64>]) -> u32 {
+        self.maps.steered_feet_fit_mask(pose, directions)
+    }
 }
 
 /// The offsets (cells, −64..=63) at which `leg` reaches its foot with the hip `height`
@@ -641,16 +649,24 @@ impl<'c> HybridGraph<'c> {
         })
     }
 
-    /// Foot cost and ground height of the cell under (x, y): `Err(true)` for an
-    /// infinite foot cost, `Err(false)` for unknown terrain or off the map.
+    /// The foot-cost heading bin of the feet of a state with orientation `theta`: the
+    /// feet stand with straight wheels, at the base heading.
     #[inline]
-    fn cell(&self, x: f64, y: f64) -> Result<(f64, f64), bool> {
+    fn bin(&self, theta: u8) -> HeadingBin {
+        self.maps.foot_heading_bin(self.lattice.yaw(theta))
+    }
+
+    /// Foot cost (at heading bin `bin`) and ground height of the cell under (x, y):
+    /// `Err(true)` for an infinite foot cost, `Err(false)` for unknown terrain or off the
+    /// map.
+    #[inline]
+    fn cell(&self, x: f64, y: f64, bin: HeadingBin) -> Result<(f64, f64), bool> {
         let hm = self.maps.heights();
         let Some((i, j)) = hm.cell_of(x, y) else {
             return Err(false);
         };
         let h = hm.get(i, j).ok_or(false)?;
-        match self.maps.foot_cost_cell(i, j) {
+        match self.maps.foot_cost_cell_at(i, j, bin) {
             CostValue::Finite(c) => Ok((c, h)),
             CostValue::Infinite => Err(true),
             CostValue::Unknown => Err(false),
@@ -660,10 +676,11 @@ impl<'c> HybridGraph<'c> {
     /// Feet of a state with offsets `o`, all on known cells of finite foot cost.
     fn feet_of(&self, s: LatticeState, o: &FootOffsets) -> Option<Feet> {
         let pos = self.feet_pos(s, o);
+        let bin = self.bin(s.theta);
         let mut cf = [0.0; 4];
         let mut h = [0.0; 4];
         for k in 0..4 {
-            let (c, hh) = self.cell(pos[k][0], pos[k][1]).ok()?;
+            let (c, hh) = self.cell(pos[k][0], pos[k][1], bin).ok()?;
             cf[k] = c;
             h[k] = hh;
         }
@@ -673,13 +690,18 @@ impl<'c> HybridGraph<'c> {
     /// Criterion 1 (Sec. V): an infinite-foot-cost cell lies closer than
     /// `step_obstacle_distance_m` to the foot at (x, y).
     #[inline]
-    fn near_obstacle(&self, p: [f64; 2]) -> bool {
+    fn near_obstacle(&self, p: [f64; 2], bin: HeadingBin) -> bool {
         let hm = self.maps.heights();
         let Some((i, j)) = hm.cell_of(p[0], p[1]) else {
             return false;
         };
         self.near[j * hm.nx() + i]
-            && self.maps.infinite_foot_cost_within(p[0], p[1], self.config.step_obstacle_distance_m)
+            && self.maps.infinite_foot_cost_within_at(
+                p[0],
+                p[1],
+                self.config.step_obstacle_distance_m,
+                Some(bin),
+            )
     }
 
     /// Longitudinal distance between the two feet on one side (left: FL–RL), m.
@@ -812,6 +834,7 @@ impl<'c> HybridGraph<'c> {
     ) -> Option<(FootOffsets, StepCost)> {
         let res = self.lattice.resolution;
         let (hx, hy) = self.heading(s.theta);
+        let bin = self.bin(s.theta);
         let [x0, y0] = feet.pos[leg];
         let h0 = feet.h[leg];
         let max_d = i32::from(self.reach[leg][1]) - i32::from(o[leg]);
@@ -833,7 +856,7 @@ impl<'c> HybridGraph<'c> {
             if dh_max > self.config.max_step_height_m {
                 break;
             }
-            let cf = match self.maps.foot_cost_cell(i, j) {
+            let cf = match self.maps.foot_cost_cell_at(i, j, bin) {
                 CostValue::Finite(c) => c,
                 CostValue::Infinite => {
                     crossed = true;
@@ -869,12 +892,18 @@ impl<'c> HybridGraph<'c> {
 
     /// Mean foot cost along a wheel pair's straight drive of `cells` cells from `p` in
     /// direction `dir` (both ends included); `None` if any cell is not drivable.
-    fn drive_line_cost(&self, p: [f64; 2], dir: (f64, f64), cells: i32) -> Option<f64> {
+    fn drive_line_cost(
+        &self,
+        p: [f64; 2],
+        dir: (f64, f64),
+        cells: i32,
+        bin: HeadingBin,
+    ) -> Option<f64> {
         let res = self.lattice.resolution;
         let mut sum = 0.0;
         for k in 0..=cells {
             let l = f64::from(k) * res;
-            let (c, _) = self.cell(p[0] + dir.0 * l, p[1] + dir.1 * l).ok()?;
+            let (c, _) = self.cell(p[0] + dir.0 * l, p[1] + dir.1 * l, bin).ok()?;
             sum += c;
         }
         Some(sum / f64::from(cells + 1))
@@ -889,7 +918,8 @@ impl<'c> HybridGraph<'c> {
         };
         let neutral = o == NEUTRAL_OFFSETS;
         let pos = self.feet_pos(s, &o);
-        let near = pos.map(|p| self.near_obstacle(p));
+        let bin = self.bin(s.theta);
+        let near = pos.map(|p| self.near_obstacle(p, bin));
         // Neutral states only have steps and front-foot-forward moves, both of which need
         // a foot close to an obstacle: the common case ends here.
         if neutral && !near.iter().any(|&n| n) {
@@ -970,7 +1000,7 @@ impl<'c> HybridGraph<'c> {
                 }
                 let back = if o[k] > 0 { (-heading.0, -heading.1) } else { heading };
                 let cells = i32::from(o[k]).abs();
-                let Some(avg) = self.drive_line_cost(feet.pos[k], back, cells) else {
+                let Some(avg) = self.drive_line_cost(feet.pos[k], back, cells, bin) else {
                     continue;
                 };
                 let mut o2 = o;
@@ -1016,6 +1046,7 @@ impl<'c> HybridGraph<'c> {
         let k = leg.index();
         let res = self.lattice.resolution;
         let (hx, hy) = self.heading(s.theta);
+        let bin = self.bin(s.theta);
         let [x0, y0] = feet.pos[k];
         let max_d = i32::from(self.reach[k][1]) - i32::from(o[k]);
         // Prefix sums of C_F along the drivable part of the line.
@@ -1024,7 +1055,7 @@ impl<'c> HybridGraph<'c> {
         let mut last = 0;
         for d in 1..=max_d.min(127) {
             let l = f64::from(d) * res;
-            match self.cell(x0 + hx * l, y0 + hy * l) {
+            match self.cell(x0 + hx * l, y0 + hy * l, bin) {
                 Ok((c, _)) => {
                     sums[d as usize] = sums[d as usize - 1] + c;
                     last = d;
@@ -1064,6 +1095,7 @@ impl<'c> HybridGraph<'c> {
     ) -> bool {
         let p = self.lattice.pose(s);
         let (hx, hy) = self.heading(s.theta);
+        let bin = self.bin(s.theta);
         let along = |q: [f64; 2]| (q[0] - p.x) * hx + (q[1] - p.y) * hy;
         let partner = Leg::ALL[leg].same_side_partner().index();
         let pj = feet.pos[partner];
@@ -1084,7 +1116,7 @@ impl<'c> HybridGraph<'c> {
         let mut moved_d = 0.0;
         while moved_d + res <= d + 1e-9 {
             let e = moved_d + res;
-            match self.cell(pj[0] + sign * e * hx, pj[1] + sign * e * hy) {
+            match self.cell(pj[0] + sign * e * hx, pj[1] + sign * e * hy, bin) {
                 Ok((_, h)) if (h - hj).abs() < 0.02 => moved_d = e,
                 _ => break,
             }
@@ -1257,7 +1289,7 @@ fn near_obstacle_layer(maps: &CostMaps, radius: f64) -> Vec<bool> {
             && j >= 0
             && (i as usize) < nx
             && (j as usize) < ny
-            && maps.foot_cost_cell(i as usize, j as usize) == CostValue::Infinite
+            && maps.foot_cost_infinite_at_some_heading(i as usize, j as usize)
     };
     let r = radius.max(0.0) + res * std::f64::consts::FRAC_1_SQRT_2;
     let reach = (r / res).ceil() as isize;

@@ -489,6 +489,21 @@ mod tests {
     }
 
     #[test]
+    fn foot_model_parses_and_a_bad_one_names_the_choices() {
+        use crate::params::FootModel;
+        assert_eq!(parse(GOOD).unwrap().params.foot_model, FootModel::Paper);
+        let wp = GOOD.replace("[params]", "[params]\nfoot_model = \"wheel_pair\"");
+        assert_eq!(parse(&wp).unwrap().params.foot_model, FootModel::WheelPair);
+        let e = parse(&GOOD.replace("[params]", "[params]\nfoot_model = \"wheels\"")).unwrap_err();
+        assert!(matches!(e, ScenarioError::Parse { .. }));
+        let msg = e.to_string();
+        assert!(
+            msg.contains("foot_model") && msg.contains("`paper`") && msg.contains("`wheel_pair`"),
+            "{msg}"
+        );
+    }
+
+    #[test]
     fn wrong_type_is_a_parse_error_naming_the_key() {
         let e = parse(&GOOD.replace("x = 4.0", "x = \"far\"")).unwrap_err();
         assert!(matches!(e, ScenarioError::Parse { .. }));
