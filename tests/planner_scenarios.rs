@@ -231,18 +231,21 @@ fn a_replan_starts_from_the_nearest_pose_a_plan_can_start_from() {
     ));
     let robot = robot();
     assert!(matches!(
-        plan::prepare(&walled, &robot, None, None),
+        plan::prepare(&walled, &robot, None, None, None),
         Err(PlanJobError::Untraversable { .. })
     ));
-    let start = plan::nearest_start(&walled, &robot, 0.15).expect("maps");
+    let start = plan::nearest_start(&walled, &robot, &PlanOptions::default(), 0.15).expect("maps");
     let moved = start.distance(&walled.start);
     assert!(moved > 0.0 && moved <= 0.15 + 1e-9, "moved {moved}");
     let mut from_there = walled.clone();
     from_there.start = start;
-    plan::prepare(&from_there, &robot, None, None).expect("a plan starts there");
+    plan::prepare(&from_there, &robot, None, None, None).expect("a plan starts there");
     // Where a plan can start, the start is kept.
     let flat = parse(&base);
-    assert_eq!(plan::nearest_start(&flat, &robot, 0.15).expect("maps"), flat.start);
+    assert_eq!(
+        plan::nearest_start(&flat, &robot, &PlanOptions::default(), 0.15).expect("maps"),
+        flat.start
+    );
 }
 
 #[test]

@@ -355,17 +355,7 @@ pub fn prepare(
 ) -> Result<Prepared, PlanJobError> {
     let t0 = Instant::now();
     let file = || scenario.path.clone();
-    let mut params = scenario.params.clone();
-    if let Some(k) = k12 {
-        params.k12 = k;
-    }
-    if let Some(f) = step_cost_factor {
-        params.step_cost_factor = f;
-    }
-    if let Some(m) = foot_model {
-        params.foot_model = m;
-    }
-    params.validate().map_err(|source| PlanJobError::Params { scenario: file(), source })?;
+    let params = params_for(scenario, k12, step_cost_factor, foot_model)?;
     let (maps, lattice) = build_maps(scenario, robot, &params)?;
     let mut states = [LatticeState::new(0, 0, 0); 2];
     for (k, (which, pose)) in
@@ -391,6 +381,29 @@ pub fn prepare(
         goal: states[1],
         setup_time_s: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// The scenario's parameters with the options' overrides, validated.
+fn params_for(
+    scenario: &Scenario,
+    k12: Option<f64>,
+    step_cost_factor: Option<f64>,
+    foot_model: Option<FootModel>,
+) -> Result<Params, PlanJobError> {
+    let mut params = scenario.params.clone();
+    if let Some(k) = k12 {
+        params.k12 = k;
+    }
+    if let Some(f) = step_cost_factor {
+        params.step_cost_factor = f;
+    }
+    if let Some(m) = foot_model {
+        params.foot_model = m;
+    }
+    params
+        .validate()
+        .map_err(|source| PlanJobError::Params { scenario: scenario.path.clone(), source })?;
+    Ok(params)
 }
 
 /// The height and cost maps of `scenario` with `params`, and the lattice over them.
@@ -441,7 +454,7 @@ fn unfit(
     }
 }
 
-/// The pose a replan starts from: `scenario.start` if the planner can start there, else
+/// The pose a replan with `opts` starts from: `scenario.start` if the planner can start there, else
 /// the nearest lattice pose within `radius_m` and two orientation steps that it can (the
 /// nearest first, then the smaller turn), else `scenario.start` (whose planning then
 /// fails with [`PlanJobError::Untraversable`]). A robot that stopped mid-manoeuvre may
@@ -453,12 +466,10 @@ fn unfit(
 pub fn nearest_start(
     scenario: &Scenario,
     robot: &RobotDescription,
+    opts: &PlanOptions,
     radius_m: f64,
 ) -> Result<Pose2, PlanJobError> {
-    let params = scenario.params.clone();
-    params
-        .validate()
-        .map_err(|source| PlanJobError::Params { scenario: scenario.path.clone(), source })?;
+    let params = params_for(scenario, opts.k12, opts.step_cost_factor, opts.foot_model)?;
     let (maps, lattice) = build_maps(scenario, robot, &params)?;
     let start = scenario.start;
     let Some(s) = lattice.state(&start) else {

@@ -682,12 +682,13 @@ pub fn execute(
                 from_here.start = truth;
                 let replan_opts =
                     PlanOptions { time_limit_s: opts.replan_time_limit_s, ..opts.plan.clone() };
-                let result = plan::nearest_start(&from_here, &robot, REPLAN_START_RADIUS_M)
-                    .map_err(RunJobError::from)
-                    .and_then(|start| {
-                        from_here.start = start;
-                        plan_mission(&from_here, sim, &replan_opts)
-                    });
+                let result =
+                    plan::nearest_start(&from_here, &robot, &replan_opts, REPLAN_START_RADIUS_M)
+                        .map_err(RunJobError::from)
+                        .and_then(|start| {
+                            from_here.start = start;
+                            plan_mission(&from_here, sim, &replan_opts)
+                        });
                 replan_wall += t.elapsed().as_secs_f64();
                 match result {
                     Ok(m) => {

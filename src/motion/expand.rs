@@ -550,7 +550,9 @@ impl<'a> Expander<'a> {
         while d + step <= target + 1e-9 {
             let e = d + step;
             let (x, y) = (pre[j][0] + sign * e * c, pre[j][1] + sign * e * s);
-            let ok = self.maps.foot_cost_at(x, y).is_finite()
+            // The wheel pair rolls along the base heading: its foot cost at that heading
+            // (the planner's support check asks the same, `locomotion::hybrid`).
+            let ok = self.maps.foot_cost_at_heading(x, y, yaw).is_finite()
                 && self.maps.height_at(x, y).is_some_and(|h| (h - pre[j][2]).abs() < 0.02);
             if !ok {
                 break;
