@@ -123,15 +123,7 @@ impl FootCostLayer {
         let weights = near.weights(params.r_n_m, res);
 
         // Per row: distance (in cells) to the nearest "too high" and "unknown" cell.
-        let too_high = |v: f64| v > params.max_foot_height_diff_m;
-        let mut dist_high = vec![0u32; nx * ny];
-        let mut dist_unknown = vec![0u32; nx * ny];
-        par_rows(&mut dist_high, nx, |y, row| {
-            row_distances(&dh[y * nx..(y + 1) * nx], too_high, false, row)
-        });
-        par_rows(&mut dist_unknown, nx, |y, row| {
-            row_distances(&dh[y * nx..(y + 1) * nx], f64::is_nan, true, row)
-        });
+        let (dist_high, dist_unknown) = row_obstacle_distances(&dh, nx, ny, params);
 
         let mut values = vec![0.0; nx * ny];
         par_bands(&mut values, nx, ny, |y0, band| {
@@ -189,15 +181,7 @@ impl FootCostLayer {
         // Which cells need the per-heading test at all: those whose bounding disc (every
         // heading's footprint lies inside it) holds a too-high or unknown cell.
         let bound = DiscRows::new(wheels.track / 2.0 + wheels.radius, res);
-        let too_high = |v: f64| v > params.max_foot_height_diff_m;
-        let mut dist_high = vec![0u32; nx * ny];
-        let mut dist_unknown = vec![0u32; nx * ny];
-        par_rows(&mut dist_high, nx, |y, row| {
-            row_distances(&dh[y * nx..(y + 1) * nx], too_high, false, row)
-        });
-        par_rows(&mut dist_unknown, nx, |y, row| {
-            row_distances(&dh[y * nx..(y + 1) * nx], f64::is_nan, true, row)
-        });
+        let (dist_high, dist_unknown) = row_obstacle_distances(&dh, nx, ny, params);
         // Per row, prefix counts of too-high and of unknown cells: a footprint row's
         // interval is then tested in O(1).
         let prefix = |pred: &dyn Fn(f64) -> bool| -> Vec<u32> {
@@ -210,7 +194,7 @@ impl FootCostLayer {
             }
             p
         };
-        let pre_high = prefix(&too_high);
+        let pre_high = prefix(&|v: f64| v > params.max_foot_height_diff_m);
         let pre_unknown = prefix(&|v: f64| v.is_nan());
 
         // Flags per cell: (infinite bits, unknown bits).
@@ -555,6 +539,28 @@ impl DiscRows {
 
 /// Per-row distance (in cells, capped) from each cell to the nearest cell whose ΔH
 /// satisfies `pred`; with `outside_counts`, the cells just past both row ends count too.
+/// Per cell, the distance in cells along its row to the nearest cell whose height
+/// difference `dh` is above `max_foot_height_diff_m`, and to the nearest unknown cell
+/// (outside the map counting as unknown): what both foot models test discs and
+/// footprints against.
+fn row_obstacle_distances(
+    dh: &[f64],
+    nx: usize,
+    ny: usize,
+    params: &Params,
+) -> (Vec<u32>, Vec<u32>) {
+    let too_high = |v: f64| v > params.max_foot_height_diff_m;
+    let mut dist_high = vec![0u32; nx * ny];
+    let mut dist_unknown = vec![0u32; nx * ny];
+    par_rows(&mut dist_high, nx, |y, row| {
+        row_distances(&dh[y * nx..(y + 1) * nx], too_high, false, row)
+    });
+    par_rows(&mut dist_unknown, nx, |y, row| {
+        row_distances(&dh[y * nx..(y + 1) * nx], f64::is_nan, true, row)
+    });
+    (dist_high, dist_unknown)
+}
+
 fn row_distances(dh: &[f64], pred: impl Fn(f64) -> bool, outside_counts: bool, out: &mut [u32]) {
     const FAR: u32 = u32::MAX / 2;
     let n = dh.len();

@@ -56,6 +56,20 @@ pub fn expand(
     sim: &mut Simulation,
     plan: &PlanSummary,
 ) -> Result<DetailedPath, DetailedJobError> {
+    expand_prefix(scenario, sim, plan, plan.path.len())
+}
+
+/// Expands the first `end` elements of `plan`'s path (the whole path for its length), on
+/// the maps the plan was made on (its k12, step cost factor and foot model).
+///
+/// # Errors
+/// [`DetailedJobError`] if the maps cannot be built or the expansion fails.
+pub fn expand_prefix(
+    scenario: &Scenario,
+    sim: &mut Simulation,
+    plan: &PlanSummary,
+    end: usize,
+) -> Result<DetailedPath, DetailedJobError> {
     let robot = sim.robot().clone();
     let prep = plan::prepare(
         scenario,
@@ -65,7 +79,8 @@ pub fn expand(
         Some(plan.foot_model),
     )?;
     let options = MotionOptions::from_params(&prep.params);
-    expand_path(&plan.path, &robot, &prep.maps, sim, &options)
+    let end = end.min(plan.path.len());
+    expand_path(&plan.path[..end], &robot, &prep.maps, sim, &options)
         .map_err(|source| DetailedJobError::Motion { scenario: scenario.name.clone(), source })
 }
 

@@ -13,6 +13,7 @@
 //! margin of MuJoCo's CoM over the wheels in contact; the scenario's expectations decide
 //! the verdict.
 
+use super::detailed::DetailedJobError;
 use super::plan::{self, PlanJobError, PlanOptions, PlanSummary};
 use super::sim::{CONTROL_HZ, SETTLE_S};
 use crate::control::path_follower::FollowerConfig;
@@ -21,7 +22,7 @@ use crate::control::step_executor::{
 };
 use crate::geometry::{Pose2, wrap_angle};
 use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor};
-use crate::motion::{DetailedPath, MotionError, MotionOptions, Phase, expand_path};
+use crate::motion::{DetailedPath, MotionError, Phase};
 use crate::progress::SimProgress;
 use crate::rng::Rng;
 use crate::robot::Leg;
@@ -487,18 +488,10 @@ pub fn expand_mission(
     plan: &PlanSummary,
     end: usize,
 ) -> Result<DetailedPath, RunJobError> {
-    let robot = sim.robot().clone();
-    let prep = plan::prepare(
-        scenario,
-        &robot,
-        Some(plan.k12),
-        Some(plan.step_cost_factor),
-        Some(plan.foot_model),
-    )?;
-    let options = MotionOptions::from_params(&prep.params);
-    let end = end.min(plan.path.len());
-    expand_path(&plan.path[..end], &robot, &prep.maps, sim, &options)
-        .map_err(|source| RunJobError::Motion { scenario: scenario.name.clone(), source })
+    super::detailed::expand_prefix(scenario, sim, plan, end).map_err(|e| match e {
+        DetailedJobError::Plan(e) => RunJobError::Plan(e),
+        DetailedJobError::Motion { scenario, source } => RunJobError::Motion { scenario, source },
+    })
 }
 
 /// Plans, expands and executes `scenario` in closed loop.
