@@ -105,7 +105,7 @@ use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
 use crate::motion::expand::{self, MotionOptions};
 use crate::motion::kinematics::hips_in_world;
-use crate::motion::standing::{EstimatedCom, StandingRule, com_estimate};
+use crate::motion::standing::{EstimatedCom, com_estimate};
 use crate::params::Params;
 use crate::planner::{Cost, FxBuild, SearchGraph};
 use crate::robot::ik::leg_ik;
@@ -208,12 +208,6 @@ pub struct HybridConfig {
     pub max_step_height_m: f64,
     /// Criterion 4: the feet on the non-stepping side must be farther apart, m.
     pub min_support_side_length_m: f64,
-    /// The leg-height rule for standing manoeuvres (reach and body clearance, Sec. VI-B).
-    pub standing: StandingRule,
-    /// Longest wheel-to-centre move the generator may make for a step, m.
-    pub max_wheel_to_centre_m: f64,
-    /// Gap the displaced wheel pair keeps to the stepping foot, m.
-    pub wheel_gap_m: f64,
     /// Smallest signed distance of the base centre to a step's support triangle, m.
     pub step_support_margin_m: f64,
     /// Shortest "front foot forward" move, m (each such move drives as far as it can).
@@ -223,19 +217,17 @@ pub struct HybridConfig {
     /// Most (cell, orientation) nodes for which the heuristic's cost-to-go keeps one
     /// layer per orientation (`cost_to_go::MAX_ORIENTED_NODES`); above, one layer.
     pub max_oriented_nodes: usize,
-    /// Driving leg height (Sec. VI-B), m: the driving posture the feasibility model checks.
-    pub driving_leg_height_m: f64,
     /// Smallest stability margin of a posture, m (the generator's requirement).
     pub min_stability_margin_m: f64,
-    /// Radius of the base's two circles (Sec. IV), m.
-    pub base_circle_radius_m: f64,
-    /// The motion generator's constants, with which steps are checked
-    /// ([`expand::step_motion`]); its margin is the generator's plus
+    /// The motion generator's constants: the leg-height rule for standing manoeuvres
+    /// (reach and leg clearance, Sec. VI-B), the driving leg height, the base circles'
+    /// radius, the wheel-to-centre move and gap of a step; with them steps are checked
+    /// ([`expand::step_motion`]), whose margin is the generator's plus
     /// [`PLANNER_MARGIN_SLACK_M`].
     pub motion: MotionOptions,
 }
 
-/// Margin the planner's step and wheel-move checks require beyond the generator's, m: the
+/// Margin the planner's step check requires beyond the generator's, m: the
 /// planner's CoM estimate ([`EstimatedCom`]) is MuJoCo's to a micrometre with the wheels
 /// level, but the roll of eqs. 6–8 is iterated to 3 mm of its target with either model,
 /// so the generator's roll may differ slightly from the planner's.
@@ -256,16 +248,11 @@ impl HybridConfig {
             step_obstacle_distance_m: params.step_obstacle_distance_m,
             max_step_height_m: params.max_step_height_m,
             min_support_side_length_m: params.min_support_side_length_m,
-            standing: StandingRule::from_params(params),
-            max_wheel_to_centre_m: params.max_wheel_to_centre_m,
-            wheel_gap_m: params.wheel_gap_m,
             step_support_margin_m: params.step_support_margin_m,
             foot_move_increment_m: 0.1,
             max_footprints: 65_536,
             max_oriented_nodes: super::cost_to_go::MAX_ORIENTED_NODES,
-            driving_leg_height_m: params.driving_leg_height_m,
             min_stability_margin_m: params.min_stability_margin_m,
-            base_circle_radius_m: params.base_circle_radius_m,
             motion: {
                 let mut m = MotionOptions::from_params(params);
                 m.min_margin_m += PLANNER_MARGIN_SLACK_M;
@@ -437,7 +424,7 @@ impl<'c> HybridGraph<'c> {
         // rule admits (pitch below 45° moves a foot less than the leg's full swing).
         let mut union = [0u128; 4];
         let top = (robot.max_leg_length() * 100.0).ceil() as i32;
-        let low = ((config.standing.min_leg_height_m - config.max_step_height_m) * 100.0)
+        let low = ((config.motion.standing.min_leg_height_m - config.max_step_height_m) * 100.0)
             .floor()
             .max(0.0) as i32;
         for cm in low..=top {
@@ -468,16 +455,16 @@ impl<'c> HybridGraph<'c> {
             maps,
             robot,
             &lattice,
-            config.base_circle_radius_m,
+            config.motion.base_circle_radius_m,
             (goal.i, goal.j),
         );
         let heuristic_setup = t0.elapsed();
         let feasibility = DrivingCheck::from_parts(
             robot,
-            config.standing,
-            config.driving_leg_height_m,
+            config.motion.standing,
+            config.motion.driving_leg_height_m,
             config.min_stability_margin_m,
-            config.base_circle_radius_m,
+            config.motion.base_circle_radius_m,
         );
         Ok(Self {
             maps,
@@ -724,6 +711,7 @@ impl<'c> HybridGraph<'c> {
         let world = Self::feet_xyz(feet);
         let (p, _) = self
             .config
+            .motion
             .standing
             .stand(&self.robot, self.maps.leg_terrain(), world, [pose.x, pose.y], pose.theta)
             .ok()?;
@@ -749,7 +737,7 @@ impl<'c> HybridGraph<'c> {
     ///   [`PLANNER_MARGIN_SLACK_M`] to spare.
     fn step_feasible(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
         let pose = self.lattice.pose(s);
-        let (robot, maps, rule) = (&self.robot, self.maps, &self.config.standing);
+        let (robot, maps, rule) = (&self.robot, self.maps, &self.config.motion.standing);
         let pre_feet = Self::feet_xyz(feet);
         let xy = [pose.x, pose.y];
         let mut heights = rule.step_heights(
@@ -1104,9 +1092,9 @@ impl<'c> HybridGraph<'c> {
         let c = &self.config;
         // Toward the centre: a front partner moves back, a rear one forward.
         let d = if partner < 2 {
-            (aj - (ai.max(ap) + c.wheel_gap_m)).clamp(0.0, c.max_wheel_to_centre_m)
+            (aj - (ai.max(ap) + c.motion.wheel_gap_m)).clamp(0.0, c.motion.max_wheel_to_centre_m)
         } else {
-            ((ai.min(ap) - c.wheel_gap_m) - aj).clamp(0.0, c.max_wheel_to_centre_m)
+            ((ai.min(ap) - c.motion.wheel_gap_m) - aj).clamp(0.0, c.motion.max_wheel_to_centre_m)
         };
         let sign = if partner < 2 { -1.0 } else { 1.0 };
         // The wheels stop, as the generator's do, before untraversable cells and height
@@ -1127,7 +1115,7 @@ impl<'c> HybridGraph<'c> {
             .map(|k| if k == partner { moved } else { feet.pos[k] })
             .collect();
         let pre = Self::feet_xyz(feet);
-        let stance = c.standing.step_posture(&self.robot, pre, leg, post, &p, height);
+        let stance = c.motion.standing.step_posture(&self.robot, pre, leg, post, &p, height);
         com_estimate(&self.robot, &stance)
             .is_ok_and(|com| stability_margin(&support, com) >= c.step_support_margin_m)
     }
@@ -1140,6 +1128,7 @@ impl<'c> HybridGraph<'c> {
         let d = f64::from(l) * self.lattice.resolution;
         let xy = [p.x + hx * d, p.y + hy * d];
         self.config
+            .motion
             .standing
             .stand(&self.robot, self.maps.leg_terrain(), Self::feet_xyz(feet), xy, p.theta)
             .is_ok()

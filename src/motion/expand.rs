@@ -661,13 +661,8 @@ impl<'a> Expander<'a> {
     }
 
     /// Expands a step of `leg` to `post_foot` from the current posture with the
-    /// candidates of `search`, committing the first that holds.
-    fn expand_step(
-        &mut self,
-        leg: Leg,
-        post_foot: [f64; 3],
-        search: StepSearch,
-    ) -> Result<(), MotionError> {
+    /// generator's candidates ([`StepSearch::Full`]), committing the first that holds.
+    fn expand_step(&mut self, leg: Leg, post_foot: [f64; 3]) -> Result<(), MotionError> {
         // The heights of the shared rule at which the step is within reach (what the
         // planner checked), then two taller stances (the soft constraint is a minimum).
         let rule = self.o.standing;
@@ -683,9 +678,8 @@ impl<'a> Expander<'a> {
                 xy,
                 yaw,
             )
-            .chain([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1])
-            .collect::<Vec<_>>();
-        self.expand_step_at(leg, post_foot, search, heights.into_iter())
+            .chain([rule.leg_height_m + 0.05, rule.leg_height_m + 0.1]);
+        self.expand_step_at(leg, post_foot, StepSearch::Full, heights)
     }
 
     /// [`Self::expand_step`] at the leg heights `heights` (lazily: the planner's check
@@ -1018,7 +1012,7 @@ pub fn expand_path(
                         ex.settle(el.kind, &path[k - 1].pose)?;
                         let f = el.feet[leg.index()];
                         let post_foot = [f[0], f[1], ex.ground(f[0], f[1])?];
-                        ex.expand_step(leg, post_foot, StepSearch::Full)?;
+                        ex.expand_step(leg, post_foot)?;
                         steps += 1;
                     }
                     (PathKind::BaseShift, _) => {
