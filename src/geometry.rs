@@ -43,6 +43,14 @@ impl Pose2 {
     }
 }
 
+/// `√(x² + y²)`: libm's `hypot` guards against overflow and underflow that metre-scale
+/// geometry never reaches, at several times the cost; the posture checks run this in
+/// their innermost loops.
+#[inline]
+pub fn norm2(x: f64, y: f64) -> f64 {
+    (x * x + y * y).sqrt()
+}
+
 /// Wraps an angle to (−π, π].
 pub fn wrap_angle(a: f64) -> f64 {
     let w = a.rem_euclid(TAU);

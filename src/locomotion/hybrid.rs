@@ -65,6 +65,21 @@
 //!   same issue). The edge cost is `max(C_BS · factor, distance moved)`, which keeps the
 //!   heuristic consistent even for factors below 2.
 //!
+//! **Lazy step checks** (issue 15). A step's checks after the scan (the standing rule's
+//! IK for the after-step state, the generator's own step check) cost about a quarter of a
+//! millisecond when they pass, and most steps the search generates are never expanded.
+//! So the search's edge for a step (`SearchGraph::successors`) goes to an *intermediate
+//! node*: the same pose with [`LatticeState::step_pending`] naming the leg, at the cost of
+//! the cheapest foothold the scan found, a lower bound of the step's. Expanding the node
+//! runs the checks (`best_step`, unchanged) and gives the step itself at the rest of its
+//! cost, or nothing. The graph is the same (paths and costs are those of checking every
+//! step at once), and the search's paths leave the nodes out
+//! (`SearchGraph::is_intermediate`). The node's heuristic is `min_c (c_c + h(t_c)) − c_lb`
+//! over the scan's footholds `c` (edge cost `c_c`, after-step state `t_c`, `c_lb` the
+//! least `c_c`): consistent into the node because the heuristic is consistent on every
+//! step from the pose, and out of it because the step taken is one of the `c`.
+//! `labelled_successors` and [`HybridGraph::edge`] give the checked steps directly.
+//!
 //! **Heuristic** (issues 4 and 15): `max(h_E, D) + S + Φ`, clamped at zero, where
 //!
 //! 1. `h_E` is that of [`DrivingGraph`]: Euclidean distance plus the orientation
@@ -139,6 +154,10 @@ impl ManoeuvreKind {
         !matches!(self, ManoeuvreKind::Drive | ManoeuvreKind::Turn)
     }
 }
+
+/// A foothold of a step by the scan (`HybridGraph::step_candidates`): C_S, the offset
+/// change in cells, the cost terms and the foothold (x, y, ground z).
+type StepCandidate = (f64, i32, StepCost, [f64; 3]);
 
 /// The parts of a step's cost C_S (eq. 5).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -225,6 +244,11 @@ pub struct HybridConfig {
     /// ([`expand::step_motion`]), whose margin is the generator's plus
     /// [`PLANNER_MARGIN_SLACK_M`].
     pub motion: MotionOptions,
+}
+
+/// The [`LatticeState::step_pending`] tag of leg index `k` (0..4).
+fn leg_tag(k: usize) -> u8 {
+    k as u8 + 1
 }
 
 /// Margin the planner's step check requires beyond the generator's, m: the
@@ -352,6 +376,22 @@ pub struct HeuristicParts {
     pub behind: Cost,
     /// Φ's part for feet ahead of neutral, c · Σ o⁺ (subtracted).
     pub ahead: Cost,
+}
+
+impl HeuristicParts {
+    /// `h = max(driving, to_go) + steps + behind − ahead`, clamped at zero; infinite
+    /// when `reachable` is.
+    pub fn total(&self) -> Cost {
+        if self.reachable.is_infinite() {
+            return Cost::INFINITY;
+        }
+        let h = self.driving.max(self.to_go).saturating_add(self.steps).saturating_add(self.behind);
+        if h.is_infinite() {
+            return h;
+        }
+        // Clamped at zero (feet ahead of neutral have paid in advance).
+        h.saturating_sub(self.ahead)
+    }
 }
 
 /// A lattice state by what it means, not by this graph's footprint ids: cell,
@@ -504,6 +544,18 @@ impl<'c> HybridGraph<'c> {
 
     /// The parts of the heuristic of `s` (see [`HeuristicParts`]).
     pub fn heuristic_parts(&self, s: LatticeState) -> HeuristicParts {
+        let o = self.footprints.get(s.footprint);
+        let feet = o.map(|o| self.feet_pos(s, &o));
+        self.parts_with(s, o.as_ref().zip(feet.as_ref()))
+    }
+
+    /// [`Self::heuristic_parts`] of the pose of `s` with foot offsets and feet positions
+    /// `footprint` (none: an unknown footprint, which adds no step bound).
+    fn parts_with(
+        &self,
+        s: LatticeState,
+        footprint: Option<(&FootOffsets, &[[f64; 2]; 4])>,
+    ) -> HeuristicParts {
         let mut p = HeuristicParts {
             reachable: Cost::ZERO,
             driving: Cost::ZERO,
@@ -517,9 +569,9 @@ impl<'c> HybridGraph<'c> {
             return p;
         }
         p.driving = self.driving.heuristic(s);
-        if let Some(o) = self.footprints.get(s.footprint) {
-            p.steps = self.step_bound.lower_bound(self.maps, &self.feet_pos(s, &o));
-            (p.behind, p.ahead) = self.step_bound.offset_potential(&o);
+        if let Some((o, feet)) = footprint {
+            p.steps = self.step_bound.lower_bound(self.maps, feet);
+            (p.behind, p.ahead) = self.step_bound.offset_potential(o);
         }
         if p.steps.is_infinite() {
             // No chain of steps reaches the goal: the cost-to-go need not be searched.
@@ -531,6 +583,30 @@ impl<'c> HybridGraph<'c> {
             p.to_go = p.to_go.saturating_add(self.driving.turn_heuristic(s));
         }
         p
+    }
+
+    /// The heuristic of an intermediate node `p` (see [`SearchGraph::heuristic`] of
+    /// this graph); `None` if its pose has no footprint or feet on finite cells, or the
+    /// scan no foothold (the node then has no successor).
+    fn pending_heuristic(&self, p: LatticeState) -> Option<Cost> {
+        let k = usize::from(p.step_pending.checked_sub(1)?);
+        let s = LatticeState { step_pending: 0, ..p };
+        let o = self.footprints.get(s.footprint)?;
+        let feet = self.feet_of(s, &o)?;
+        let f = self.config.step_cost_factor;
+        let candidates = self.step_candidates(s, &o, &feet, k);
+        let charged = edge_cost(f * candidates.first()?.0);
+        let best = candidates
+            .iter()
+            .map(|&(c_s, d, _, _)| {
+                let mut o2 = o;
+                o2[k] = (i32::from(o[k]) + d) as i8;
+                // The after-step state's own heuristic: its feet as `feet_pos` places them.
+                let h = self.parts_with(s, Some((&o2, &self.feet_pos(s, &o2)))).total();
+                edge_cost(f * c_s).saturating_add(h)
+            })
+            .min()?;
+        Some(best.saturating_sub(charged))
     }
 
     /// Stops the heuristic's cost-to-go from growing after `deadline` (the plan's time
@@ -615,7 +691,7 @@ impl<'c> HybridGraph<'c> {
 
     /// Pose cost of a neutral state (the driving cost, ≥ 1), `None` if untraversable.
     pub fn driving_pose_cost(&mut self, s: LatticeState) -> Option<f64> {
-        self.driving.pose_cost(LatticeState { footprint: NEUTRAL_FOOTPRINT, ..s })
+        self.driving.pose_cost(LatticeState { footprint: NEUTRAL_FOOTPRINT, step_pending: 0, ..s })
     }
 
     #[inline]
@@ -820,6 +896,20 @@ impl<'c> HybridGraph<'c> {
         feet: &Feet,
         leg: usize,
     ) -> Option<(FootOffsets, StepCost)> {
+        let candidates = self.step_candidates(s, o, feet, leg);
+        self.first_feasible_step(s, o, feet, leg, candidates)
+    }
+
+    /// The footholds of `best_step` by the scan alone (C_S, offset change, cost terms,
+    /// foothold x, y, z), cheapest first (ties: the shorter step): the checks that need
+    /// the IK are left to [`Self::first_feasible_step`].
+    fn step_candidates(
+        &self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        leg: usize,
+    ) -> Vec<StepCandidate> {
         let res = self.lattice.resolution;
         let (hx, hy) = self.heading(s.theta);
         let bin = self.bin(s.theta);
@@ -830,7 +920,7 @@ impl<'c> HybridGraph<'c> {
         let mut dh_max = 0.0_f64;
         // Footholds by the scan: (C_S, offset, cost terms, foothold). The checks that
         // need the IK run afterwards in order of C_S, and stop at the first that holds.
-        let mut candidates: Vec<(f64, i32, StepCost, [f64; 3])> = Vec::new();
+        let mut candidates: Vec<StepCandidate> = Vec::new();
         for d in 1..=max_d {
             let l = f64::from(d) * res;
             let (x, y) = (x0 + hx * l, y0 + hy * l);
@@ -861,6 +951,19 @@ impl<'c> HybridGraph<'c> {
         }
         // Cheapest first; ties: the shorter step (the scan order, kept by a stable sort).
         candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+        candidates
+    }
+
+    /// The first of `candidates` (from [`Self::step_candidates`]) whose after-step state
+    /// may be entered and whose step passes [`Self::step_feasible`], with its offsets.
+    fn first_feasible_step(
+        &mut self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        leg: usize,
+        candidates: Vec<StepCandidate>,
+    ) -> Option<(FootOffsets, StepCost)> {
         candidates.into_iter().find_map(|(_, d, cost, foothold)| {
             let mut o2 = *o;
             o2[leg] = (i32::from(o[leg]) + d) as i8;
@@ -898,8 +1001,10 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// Appends the labelled non-driving successors of `s` (steps, base shifts, foot
-    /// moves) to `self.special`.
-    fn special_successors(&mut self, s: LatticeState) {
+    /// moves) to `self.special`. With `lazy`, a step's successor is its intermediate node
+    /// at the cheapest foothold's cost (see "Lazy step checks" in the module docs), else
+    /// the step itself.
+    fn special_successors(&mut self, s: LatticeState, lazy: bool) {
         self.special.clear();
         let Some(o) = self.footprints.get(s.footprint) else {
             return;
@@ -930,25 +1035,29 @@ impl<'c> HybridGraph<'c> {
             if self.side_length(&o, !leg.is_left()) <= self.config.min_support_side_length_m {
                 continue;
             }
-            let Some((o2, step)) = self.best_step(s, &o, &feet, k) else {
+            if lazy {
+                // The cheapest foothold by the scan: a lower bound of the step's cost.
+                let Some(&(c_s, _, step, _)) = self.step_candidates(s, &o, &feet, k).first() else {
+                    continue;
+                };
+                let pending = LatticeState { step_pending: leg_tag(k), ..s };
+                let cost = f * c_s;
+                self.special.push((
+                    pending,
+                    edge_cost(cost),
+                    Manoeuvre {
+                        kind: ManoeuvreKind::Step,
+                        leg: Some(leg),
+                        length_m: step.length_m,
+                        cost,
+                        step: Some(step),
+                    },
+                ));
                 continue;
-            };
-            let Some(t) = self.with_footprint(s, o2) else {
-                continue;
-            };
-            let cost = f * step.c_s;
-            self.stats.steps += 1;
-            self.special.push((
-                t,
-                edge_cost(cost),
-                Manoeuvre {
-                    kind: ManoeuvreKind::Step,
-                    leg: Some(leg),
-                    length_m: step.length_m,
-                    cost,
-                    step: Some(step),
-                },
-            ));
+            }
+            if let Some(edge) = self.checked_step(s, &o, &feet, k) {
+                self.special.push(edge);
+            }
         }
 
         // Longitudinal base shift: both front feet ahead of neutral; forward until a
@@ -999,6 +1108,43 @@ impl<'c> HybridGraph<'c> {
                 }
             }
         }
+    }
+
+    /// The step of leg `k` from state `s` (offsets `o`, feet `feet`) to the cheapest
+    /// foothold that passes every check (`best_step`), labelled, at its full cost.
+    fn checked_step(
+        &mut self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        k: usize,
+    ) -> Option<(LatticeState, Cost, Manoeuvre)> {
+        let (o2, step) = self.best_step(s, o, feet, k)?;
+        let t = self.with_footprint(s, o2)?;
+        let cost = self.config.step_cost_factor * step.c_s;
+        self.stats.steps += 1;
+        let m = Manoeuvre {
+            kind: ManoeuvreKind::Step,
+            leg: Some(Leg::ALL[k]),
+            length_m: step.length_m,
+            cost,
+            step: Some(step),
+        };
+        Some((t, edge_cost(cost), m))
+    }
+
+    /// The successor of an intermediate node `p` (see "Lazy step checks" in the module
+    /// docs): its step, checked now, at the rest of its cost (the full cost less what
+    /// the edge into `p` charged). `None` when no foothold passes the checks.
+    fn pending_step(&mut self, p: LatticeState) -> Option<(LatticeState, Cost, Manoeuvre)> {
+        let k = usize::from(p.step_pending.checked_sub(1)?);
+        let s = LatticeState { step_pending: 0, ..p };
+        let o = self.footprints.get(s.footprint)?;
+        let feet = self.feet_of(s, &o)?;
+        let &(c_lb, ..) = self.step_candidates(s, &o, &feet, k).first()?;
+        let charged = edge_cost(self.config.step_cost_factor * c_lb);
+        let (t, cost, m) = self.checked_step(s, &o, &feet, k)?;
+        Some((t, cost.saturating_sub(charged), m))
     }
 
     fn push_foot_move(
@@ -1186,7 +1332,7 @@ impl<'c> HybridGraph<'c> {
     /// Every successor of `s` with its cost and label, in the search's order.
     pub fn labelled_successors(&mut self, s: LatticeState) -> Vec<(LatticeState, Cost, Manoeuvre)> {
         let mut out = Vec::new();
-        if s.footprint == NEUTRAL_FOOTPRINT {
+        if s.footprint == NEUTRAL_FOOTPRINT && s.step_pending == 0 {
             let mut plain = Vec::new();
             self.driving.successors(s, &mut plain);
             let a = self.lattice.pose(s);
@@ -1213,7 +1359,11 @@ impl<'c> HybridGraph<'c> {
                 out.push((t, c, m));
             }
         }
-        self.special_successors(s);
+        if s.step_pending != 0 {
+            out.extend(self.pending_step(s));
+            return out;
+        }
+        self.special_successors(s, false);
         out.extend_from_slice(&self.special);
         out
     }
@@ -1317,11 +1467,15 @@ impl SearchGraph for HybridGraph<'_> {
 
     fn successors(&mut self, s: LatticeState, out: &mut Vec<(LatticeState, Cost)>) {
         let first = out.len();
-        if s.footprint == NEUTRAL_FOOTPRINT {
-            self.driving.successors(s, out);
+        if s.step_pending != 0 {
+            out.extend(self.pending_step(s).map(|(t, c, _)| (t, c)));
+        } else {
+            if s.footprint == NEUTRAL_FOOTPRINT {
+                self.driving.successors(s, out);
+            }
+            self.special_successors(s, true);
+            out.extend(self.special.iter().map(|&(t, c, _)| (t, c)));
         }
-        self.special_successors(s);
-        out.extend(self.special.iter().map(|&(t, c, _)| (t, c)));
         if !self.forbidden.is_empty()
             && let Some(from) = self.key(s)
         {
@@ -1342,21 +1496,24 @@ impl SearchGraph for HybridGraph<'_> {
     /// bound Σ_k S_k of the four feet and the foot-offset potential Φ (`heuristic`
     /// module), clamped at zero: consistent on every manoeuvre (see the module docs of
     /// all three and of this module).
+    ///
+    /// An intermediate node of a lazy step (see "Lazy step checks" in the module docs)
+    /// gets `min_c (c_c + h(t_c)) − c_lb` over the step's footholds `c` by the scan (edge
+    /// cost `c_c` and after-step state `t_c`; `c_lb` the least `c_c`, which the edge into
+    /// the node charged), consistent on both of its edges.
     fn heuristic(&self, s: LatticeState) -> Cost {
-        let p = self.heuristic_parts(s);
-        if p.reachable.is_infinite() {
-            return Cost::INFINITY;
+        if s.step_pending == 0 {
+            return self.heuristic_parts(s).total();
         }
-        let h = p.driving.max(p.to_go).saturating_add(p.steps).saturating_add(p.behind);
-        if h.is_infinite() {
-            return h;
-        }
-        // Clamped at zero (feet ahead of neutral have paid in advance).
-        h.saturating_sub(p.ahead)
+        self.pending_heuristic(s).unwrap_or(Cost::INFINITY)
     }
 
     fn is_goal(&self, s: LatticeState) -> bool {
-        self.driving.is_goal(s)
+        s.step_pending == 0 && self.driving.is_goal(s)
+    }
+
+    fn is_intermediate(&self, s: LatticeState) -> bool {
+        s.step_pending != 0
     }
 
     fn dense_len(&self) -> usize {
@@ -1370,6 +1527,7 @@ impl SearchGraph for HybridGraph<'_> {
     #[inline]
     fn dense_index(&self, s: LatticeState) -> Option<usize> {
         if s.footprint != NEUTRAL_FOOTPRINT
+            || s.step_pending != 0
             || !self.lattice.contains(i32::from(s.i), i32::from(s.j))
         {
             return None;

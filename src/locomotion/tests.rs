@@ -544,7 +544,9 @@ mod hybrid {
         assert!(pf.to_go.to_f64() >= pf.driving.to_f64() - 1e-4, "{pf:?}");
     }
 
-    /// Checks `h(s) ≤ c(s, t) + h(t)` on every labelled successor of `s`; returns the
+    /// Checks `h(s) ≤ c(s, t) + h(t)` on every labelled successor of `s` and on every
+    /// edge the search itself takes out of `s` and out of the lazy steps' intermediate
+    /// nodes it reaches (`hybrid` module docs, "Lazy step checks"); returns the labelled
     /// successors.
     fn check_consistent(
         g: &mut HybridGraph<'_>,
@@ -555,7 +557,56 @@ mod hybrid {
             let (hs, ht) = (g.heuristic(s), g.heuristic(t));
             assert!(hs <= c.saturating_add(ht), "h = {hs} > {c} + {ht}: {m:?} from {s:?} to {t:?}");
         }
+        let mut search_edges = Vec::new();
+        g.successors(s, &mut search_edges);
+        for (p, c) in search_edges {
+            let (hs, hp) = (g.heuristic(s), g.heuristic(p));
+            assert!(hs <= c.saturating_add(hp), "h = {hs} > {c} + {hp}: from {s:?} to {p:?}");
+            if g.is_intermediate(p) {
+                let mut rest = Vec::new();
+                g.successors(p, &mut rest);
+                for (t, c2) in rest {
+                    let ht = g.heuristic(t);
+                    assert!(hp <= c2.saturating_add(ht), "h = {hp} > {c2} + {ht}: {p:?} to {t:?}");
+                    // The two parts add up to the step the labelled successors give.
+                    let full = succ.iter().find(|(u, _, _)| *u == t).map(|&(_, c, _)| c);
+                    assert_eq!(full, Some(c.saturating_add(c2)), "{s:?} to {t:?} via {p:?}");
+                }
+            }
+        }
         succ
+    }
+
+    #[test]
+    fn steps_are_checked_lazily_and_paths_leave_their_intermediate_nodes_out() {
+        // The step onto the platform reaches an intermediate node at the cheapest
+        // foothold's cost; the node's successor is the checked step, and the two parts
+        // cost what the step does. A* returns poses only, at the same cost.
+        let maps = platform_maps(0.2);
+        let goal = LatticeState::new(120, 40, 0);
+        let mut g = graph(&maps, goal);
+        let s = state_at(&g, 0.48, 0.0);
+        let mut out = Vec::new();
+        g.successors(s, &mut out);
+        let pending: Vec<_> = out.iter().filter(|(p, _)| g.is_intermediate(*p)).collect();
+        assert_eq!(pending.len(), 2, "a step node per front leg: {out:?}");
+        for &&(p, _) in &pending {
+            assert_eq!((p.i, p.j, p.theta, p.footprint), (s.i, s.j, s.theta, s.footprint));
+            assert!(!g.is_goal(p));
+        }
+        let before = g.stats().steps;
+        check_consistent(&mut g, s);
+        assert!(g.stats().steps > before, "expanding a node checks its step");
+        let start = state_at(&g, 0.0, 0.0);
+        let r = astar(&mut g, start, &SearchParams::default());
+        let best = r.best().expect("a path onto the platform");
+        assert!(best.path.iter().all(|&t| !g.is_intermediate(t)));
+        let edges: Cost = best
+            .path
+            .windows(2)
+            .map(|w| g.edge(w[0], w[1]).expect("consecutive poses are joined").0)
+            .sum();
+        assert_eq!(edges, best.cost);
     }
 
     #[test]

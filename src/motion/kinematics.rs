@@ -9,7 +9,7 @@
 //! (Sec. VI-A) and is bounded by [`MAX_LATERAL_MISMATCH_M`] for feet in contact.
 
 use super::CenterOfMassModel;
-use crate::geometry::Pose2;
+use crate::geometry::{Pose2, norm2};
 use crate::robot::ik::{IkError, ankle_of_contact, leg_ik};
 use crate::robot::{Leg, RobotDescription};
 use crate::stability::{convex_hull, stability_margin};
@@ -155,7 +155,7 @@ pub fn solve_legs(
             return Err(PostureError::Lateral { leg, offset: c[1] });
         }
         let ankle = ankle_of_contact(robot, [c[0], c[2]], pitch);
-        let distance = ankle[0].hypot(ankle[1]);
+        let distance = norm2(ankle[0], ankle[1]);
         if distance > reach - reach_margin {
             return Err(PostureError::ReachMargin { leg, distance, margin: reach_margin });
         }
@@ -183,7 +183,7 @@ pub fn evaluate(
         (0..4).filter(|&i| p.contact[i]).map(|i| [p.feet[i][0], p.feet[i][1]]).collect();
     let margin = stability_margin(&support, [com[0], com[1]]);
     let centroid_distance =
-        support_centroid(&support).map_or(f64::INFINITY, |c| (c[0] - com[0]).hypot(c[1] - com[1]));
+        support_centroid(&support).map_or(f64::INFINITY, |c| norm2(c[0] - com[0], c[1] - com[1]));
     Ok(Evaluation { joints, leg_heights, com, margin, centroid_distance })
 }
 

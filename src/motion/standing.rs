@@ -21,7 +21,7 @@
 
 use super::CenterOfMassModel;
 use super::kinematics::{Posture, PostureError, apply, pitch_from_feet, rotation, solve_legs};
-use crate::geometry::Pose2;
+use crate::geometry::{Pose2, norm2};
 use crate::params::Params;
 use crate::robot::RobotDescription;
 use crate::robot::ik::{knee_and_ankle, leg_fk, world_down};
@@ -218,7 +218,16 @@ impl StandingRule {
         // The swing height scans the terrain around the path, the dearest part: only
         // when both ground stances pass the distance check at some height (a quarter of
         // the planner's candidate footholds on the platform end here).
-        let grounded = self.heights().any(|h| probes.iter().all(|p| p.distances_ok(h).is_ok()));
+        let window = |probes: &[ReachProbe]| {
+            probes
+                .iter()
+                .map(ReachProbe::height_window)
+                .fold((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi), (l, h)| (lo.max(l), hi.min(h)))
+        };
+        let (lo, hi) = window(&probes);
+        let grounded = self
+            .heights()
+            .any(|h| (lo..=hi).contains(&h) && probes.iter().all(|p| p.distances_ok(h).is_ok()));
         if grounded {
             let swing_z = self.swing_z(robot, heights, pre[leg], post_foot);
             // The swing at most 5 cm apart, ends included, and where the foot passes
@@ -255,9 +264,10 @@ impl StandingRule {
         // first at the next height: mostly the same one fails (the foot lifted at one end
         // of its swing folds the leg past a joint limit), so a rejected height costs one
         // IK instead of several.
+        let (lo, hi) = window(&probes);
         let tried = if grounded { Some(self.heights()) } else { None };
         tried.into_iter().flatten().filter(move |&h| {
-            if !probes.iter().all(|p| p.distances_ok(h).is_ok()) {
+            if !(lo..=hi).contains(&h) || !probes.iter().all(|p| p.distances_ok(h).is_ok()) {
                 return false;
             }
             let failed = variants.iter().position(|feet| {
@@ -355,6 +365,53 @@ impl ReachProbe {
         }
     }
 
+    /// The leg heights `[lo, hi]` outside which [`Self::distances_ok`] fails (empty when
+    /// `lo > hi`), widened by 1 µm so that rounding never drops a height that passes:
+    /// at leg height `h = h0 − d` each foot sits at `c + d·u` in the base frame, so the
+    /// lateral test is linear in `d` and the reach test `|p + d·u| ≤ limit` quadratic,
+    /// each true on one interval of `d`. The check of every height against every stance
+    /// of a step's swing then costs one interval per stance instead of one test per
+    /// height.
+    fn height_window(&self) -> (f64, f64) {
+        const WIDEN: f64 = 1e-6;
+        let (mut d_lo, mut d_hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        for i in 0..4 {
+            let c = self.local0[i];
+            if self.contact[i] {
+                // |c₁ + d·u₁| ≤ M.
+                let m = super::kinematics::MAX_LATERAL_MISMATCH_M;
+                if self.up[1] == 0.0 {
+                    if c[1].abs() > m {
+                        return (f64::INFINITY, f64::NEG_INFINITY);
+                    }
+                } else {
+                    let (a, b) = ((-m - c[1]) / self.up[1], (m - c[1]) / self.up[1]);
+                    d_lo = d_lo.max(a.min(b));
+                    d_hi = d_hi.min(a.max(b));
+                }
+            }
+            // |p + d·u|² ≤ limit²: (u·u) d² + 2 (p·u) d + p·p − limit² ≤ 0.
+            let p = [c[0] + self.ankle[0], c[2] + self.ankle[1]];
+            let u = [self.up[0], self.up[2]];
+            let (qa, qb) = (u[0] * u[0] + u[1] * u[1], p[0] * u[0] + p[1] * u[1]);
+            let qc = p[0] * p[0] + p[1] * p[1] - self.limit * self.limit;
+            if qa <= 0.0 {
+                if qc > 0.0 {
+                    return (f64::INFINITY, f64::NEG_INFINITY);
+                }
+                continue;
+            }
+            let disc = qb * qb - qa * qc;
+            if disc < 0.0 {
+                return (f64::INFINITY, f64::NEG_INFINITY);
+            }
+            let w = disc.sqrt();
+            d_lo = d_lo.max((-qb - w) / qa);
+            d_hi = d_hi.min((-qb + w) / qa);
+        }
+        (self.h0 - d_hi - WIDEN, self.h0 - d_lo + WIDEN)
+    }
+
     /// Whether every leg's hip-to-ankle distance at leg height `h` leaves the reach
     /// margin, and every foot in contact lies on its leg plane (as [`solve_legs`]).
     fn distances_ok(&self, h: f64) -> Result<(), PostureError> {
@@ -369,7 +426,7 @@ impl ReachProbe {
             if self.contact[i] && c[1].abs() > super::kinematics::MAX_LATERAL_MISMATCH_M {
                 return Err(PostureError::Lateral { leg, offset: c[1] });
             }
-            let distance = (c[0] + self.ankle[0]).hypot(c[2] + self.ankle[1]);
+            let distance = norm2(c[0] + self.ankle[0], c[2] + self.ankle[1]);
             if distance > self.limit {
                 return Err(PostureError::ReachMargin { leg, distance, margin: self.reach_margin });
             }
@@ -617,6 +674,18 @@ mod tests {
                 let world = feet.map(|f| [c3 * f[0] - s3 * f[1], s3 * f[0] + c3 * f[1], f[2]]);
                 let probe =
                     ReachProbe::new(&robot, &world, [true; 4], [0.0, 0.0], rpy, &ground, &r);
+                // The analytic window holds every height that passes (checked on a
+                // 1 mm grid, through and past the rule's heights) and nothing 2 µm
+                // inside its ends fails.
+                let (lo, hi) = probe.height_window();
+                for k in 0..=700 {
+                    let h = f64::from(k) * 1e-3;
+                    if probe.distances_ok(h).is_ok() {
+                        assert!((lo..=hi).contains(&h), "{rear_dx} {up} {h}: [{lo}, {hi}]");
+                    } else {
+                        assert!(!(lo + 2e-6..=hi - 2e-6).contains(&h), "{rear_dx} {up} {h}");
+                    }
+                }
                 for h in r.heights() {
                     let p = level_posture(&robot, world, [true; 4], [0.0, 0.0], rpy, h, ground);
                     let full = solve_legs(&robot, &p, r.reach_margin_m);

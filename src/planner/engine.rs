@@ -210,6 +210,8 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
         let cost = path_cost(&mut *self.graph, &path, &mut self.succ, |i| {
             store.get(ids[i + 1]).g.saturating_sub(store.get(ids[i]).g)
         });
+        let graph = &*self.graph;
+        let path = path.into_iter().filter(|&s| !graph.is_intermediate(s)).collect();
         (path, cost)
     }
 

@@ -38,6 +38,18 @@ pub trait SearchGraph {
     /// Whether `state` is a goal.
     fn is_goal(&self, state: Self::State) -> bool;
 
+    /// Optional: whether `state` is the intermediate node of a lazily evaluated edge
+    /// (default: none is). A graph may split an edge whose validity is expensive to check
+    /// into a cheap edge, at a lower bound of its cost, to an intermediate node, and the
+    /// rest of the cost from that node on, checking the edge only when the search expands
+    /// the node (as in Lazy Weighted A*, Cohen, Phillips & Likhachev 2014). Returned paths
+    /// leave intermediate nodes out; their cost is the sum of both parts. The heuristic
+    /// must stay consistent on both parts.
+    fn is_intermediate(&self, state: Self::State) -> bool {
+        let _ = state;
+        false
+    }
+
     /// Optional: the size of a dense index space, `0` (the default) if the graph has none.
     ///
     /// A graph whose states (or most of them, e.g. the cells × orientations of a lattice)
@@ -75,6 +87,10 @@ impl<G: SearchGraph + ?Sized> SearchGraph for &mut G {
 
     fn is_goal(&self, state: Self::State) -> bool {
         (**self).is_goal(state)
+    }
+
+    fn is_intermediate(&self, state: Self::State) -> bool {
+        (**self).is_intermediate(state)
     }
 
     fn dense_len(&self) -> usize {

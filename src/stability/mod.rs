@@ -6,6 +6,8 @@
 //! no area to stand on and the margin is minus the distance to the contacts' hull (a point
 //! or segment), so it is never positive.
 
+use crate::geometry::norm2;
+
 /// Convex hull of points in the plane, counter-clockwise, without collinear points
 /// (Andrew's monotone chain). Deterministic for equal inputs.
 pub fn convex_hull(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
@@ -46,7 +48,7 @@ pub fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     } else {
         0.0
     };
-    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+    norm2(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy)
 }
 
 /// Signed distance of `com` (horizontal projection) to the boundary of the convex hull of
@@ -55,7 +57,7 @@ pub fn stability_margin(contacts: &[[f64; 2]], com: [f64; 2]) -> f64 {
     let hull = convex_hull(contacts);
     match hull.len() {
         0 => f64::NEG_INFINITY,
-        1 => -(com[0] - hull[0][0]).hypot(com[1] - hull[0][1]),
+        1 => -norm2(com[0] - hull[0][0], com[1] - hull[0][1]),
         2 => -segment_distance(com, hull[0], hull[1]),
         n => {
             let mut inside = true;

@@ -399,36 +399,62 @@ impl HeightMap {
     /// Highest known terrain over the cells whose centres lie within `radius` of the
     /// segment from `a` to `b` (x, y; the ends' z count too), m: what a foot carried along
     /// the segment must clear.
+    ///
+    /// The set within `radius` of a segment is convex (a segment dilated by a disc), so
+    /// each row of cell centres meets it in one interval: the union of the intervals of
+    /// the two end discs and of the band between them. Each row is then a contiguous
+    /// slice (the step check calls this for every candidate foothold).
     pub fn max_height_near_segment(&self, a: [f64; 3], b: [f64; 3], radius: f64) -> f64 {
         let mut best = a[2].max(b[2]);
+        if radius.is_nan() || radius < 0.0 || self.nx == 0 {
+            return best;
+        }
         let res = self.resolution;
         let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
         let len2 = dx * dx + dy * dy;
-        let r2 = radius * radius;
-        let lo = |v: f64, o: f64| (((v - radius - o) / res).floor().max(0.0)) as usize;
-        let hi = |v: f64, o: f64, n: usize| {
-            ((((v + radius - o) / res).floor()).max(-1.0) as i64).min(n as i64 - 1)
-        };
-        let (i0, j0) = (lo(a[0].min(b[0]), self.origin[0]), lo(a[1].min(b[1]), self.origin[1]));
-        let i1 = hi(a[0].max(b[0]), self.origin[0], self.nx);
-        let j1 = hi(a[1].max(b[1]), self.origin[1], self.ny);
-        for j in j0 as i64..=j1 {
-            for i in i0 as i64..=i1 {
-                let (i, j) = (i as usize, j as usize);
-                let [cx, cy] = self.cell_center(i, j);
-                // Squared distance from the cell centre to the segment.
-                let t = if len2 > 0.0 {
-                    (((cx - a[0]) * dx + (cy - a[1]) * dy) / len2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let (ex, ey) = (a[0] + t * dx - cx, a[1] + t * dy - cy);
-                if ex * ex + ey * ey <= r2
-                    && let Some(h) = self.get(i, j)
-                {
-                    best = best.max(h);
+        let reach = radius * len2.sqrt();
+        let first_row = ((a[1].min(b[1]) - radius - self.origin[1]) / res - 0.5).ceil().max(0.0);
+        let last_row = ((a[1].max(b[1]) + radius - self.origin[1]) / res - 0.5).floor();
+        let last_row = last_row.min(self.ny as f64 - 1.0);
+        // NaN ends compare false: nothing to scan.
+        if first_row.partial_cmp(&last_row).is_none_or(|o| o.is_gt()) {
+            return best;
+        }
+        for j in first_row as usize..=last_row as usize {
+            let cy = self.origin[1] + (j as f64 + 0.5) * res;
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for end in [a, b] {
+                let h2 = radius * radius - (cy - end[1]) * (cy - end[1]);
+                if h2 >= 0.0 {
+                    let w = h2.sqrt();
+                    lo = lo.min(end[0] - w);
+                    hi = hi.max(end[0] + w);
                 }
             }
+            if len2 > 0.0 {
+                // Projection onto the segment in [0, len²], perpendicular offset within
+                // radius · |b − a|: two conditions linear in x.
+                let ey = cy - a[1];
+                let along = solve_linear(dx, -ey * dy, len2 - ey * dy);
+                let across = solve_linear(dy, ey * dx - reach, ey * dx + reach);
+                if let (Some((l1, h1)), Some((l2, h2))) = (along, across) {
+                    let (l, h) = (l1.max(l2), h1.min(h2));
+                    if l <= h {
+                        lo = lo.min(a[0] + l);
+                        hi = hi.max(a[0] + h);
+                    }
+                }
+            }
+            let i0 = ((lo - self.origin[0]) / res - 0.5).ceil().max(0.0);
+            let i1 = ((hi - self.origin[0]) / res - 0.5).floor().min(self.nx as f64 - 1.0);
+            if i0.partial_cmp(&i1).is_none_or(|o| o.is_gt()) {
+                continue;
+            }
+            let row = j * self.nx;
+            // NaN (unknown) never wins a `max`.
+            best = self.data[row + i0 as usize..=row + i1 as usize]
+                .iter()
+                .fold(best, |m, &h| m.max(h));
         }
         best
     }
@@ -548,6 +574,20 @@ impl<'a> HeightMapView<'a> {
     }
 }
 
+/// The `u` with `k · u` in `[lo, hi]`, as an interval: all of ℝ (infinite ends) when
+/// `k = 0` and `0` lies in `[lo, hi]`, `None` when it is empty.
+fn solve_linear(k: f64, lo: f64, hi: f64) -> Option<(f64, f64)> {
+    if k > 0.0 {
+        Some((lo / k, hi / k))
+    } else if k < 0.0 {
+        Some((hi / k, lo / k))
+    } else if lo <= 0.0 && 0.0 <= hi {
+        Some((f64::NEG_INFINITY, f64::INFINITY))
+    } else {
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
 
@@ -646,6 +686,48 @@ mod tests {
         assert_eq!(seg(0.45, 0.61), 0.5);
         // The ends' own heights count; off the map nothing is seen.
         assert_eq!(hm.max_height_near_segment([5.0, 5.0, 0.1], [6.0, 5.0, 0.2], 0.3), 0.2);
+    }
+
+    /// The definition, cell by cell: every cell centre's distance to the segment.
+    fn max_near_segment_per_cell(hm: &HeightMap, a: [f64; 3], b: [f64; 3], r: f64) -> f64 {
+        let mut best = a[2].max(b[2]);
+        let (nx, ny) = hm.dims();
+        for j in 0..ny {
+            for i in 0..nx {
+                let c = hm.cell_center(i, j);
+                let d = crate::stability::segment_distance(c, [a[0], a[1]], [b[0], b[1]]);
+                if d <= r
+                    && let Some(h) = hm.get(i, j)
+                {
+                    best = best.max(h);
+                }
+            }
+        }
+        best
+    }
+
+    proptest::proptest! {
+        /// Row intervals find what the per-cell definition finds (cells closer than 1 µm
+        /// to the radius may go either way), on a map of distinct random heights with
+        /// unknown cells, for segments of any direction and length, partly off the map.
+        #[test]
+        fn max_height_near_segment_is_the_per_cell_maximum(
+            a in proptest::array::uniform2(-0.3f64..1.3),
+            b in proptest::array::uniform2(-0.3f64..1.3),
+            r in 0.0f64..0.4,
+            seed in 0u64..1000,
+        ) {
+            let hm = HeightMap::from_fn([0.0, 0.0], 0.05, 20, 20, |i, j| {
+                let v = ((i * 31 + j * 17) as u64 * 2654435761 + seed) % 1000;
+                if v < 50 { f64::NAN } else { v as f64 * 1e-3 }
+            })
+            .unwrap();
+            let (a, b) = ([a[0], a[1], -1.0], [b[0], b[1], -1.0]);
+            let got = hm.max_height_near_segment(a, b, r);
+            let inner = max_near_segment_per_cell(&hm, a, b, (r - 1e-6).max(0.0));
+            let outer = max_near_segment_per_cell(&hm, a, b, r + 1e-6);
+            proptest::prop_assert!(inner <= got && got <= outer, "{inner} {got} {outer}");
+        }
     }
 
     use super::*;
