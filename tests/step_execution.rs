@@ -3,8 +3,9 @@
 //! each lift and contact confirmed before weight goes back onto a placed foot.
 //!
 //! The paper's two missions whole (plan, expand, execute: goal reached, every step
-//! executed, margin kept, no tip-over, no body collision), a push during a swing, and an
-//! aborted step with its replan.
+//! executed, margin kept, no tip-over, no body collision), a push during a swing, an
+//! aborted step with its replan, and a generated step down whose sunken base once carried
+//! a knee into the edge.
 
 mod common;
 
@@ -309,4 +310,25 @@ fn an_aborted_step_returns_to_the_driving_posture_and_replans() {
     assert!((base.position[2] - ground - 0.32).abs() < 0.03, "{:?} over {ground}", base.position);
     assert_eq!(sim.wheel_contacts().iter().filter(|c| c.touching()).count(), 8);
     assert!(!s.tipped && s.body_collisions.is_empty(), "{s:#?}");
+}
+
+/// A generated step down (`momaro generate --class step_down --seed 98`: a 0.168 m block
+/// whose edge the robot leaves front legs first) whose lifted front leg folded its knee
+/// under its hip into the edge: the support legs, position servos under the robot's
+/// weight, let the base sink below its keyframes, and the knee with it. The executor
+/// now holds the base height (`ExecutorConfig::base_hold_gain`): no leg link touches
+/// the terrain, and the mission passes.
+#[test]
+fn a_generated_step_down_keeps_its_knees_off_the_edge() {
+    use momaro::jobs::generate::checked_case;
+    use momaro::scenario::generate::Class;
+    let model = common::model();
+    let robot = Simulation::robot_only(&model).expect("model").robot().clone();
+    let dir = common::temp_dir("generated_step_down");
+    let (case, _) = checked_case(Class::StepDown, 98, &dir, &robot).expect("generated");
+    let sc = case.scenario(&dir).expect("scenario");
+    let s = run::run(&sc, &RunOptions::new(plan_options(), model)).expect("run");
+    assert!(s.steps_planned > 0);
+    assert_clean(&s);
+    assert!(s.passed, "{s:#?}");
 }

@@ -557,6 +557,7 @@ fn observe(sim: &Simulation, measured: Pose2) -> Observation {
     Observation {
         time: sim.time(),
         base: measured,
+        base_z: Some(sim.base().position[2]),
         joints: Leg::ALL.map(|l| sim.leg_joints(l)),
         steering: Leg::ALL.map(|l| sim.steering_angle(l)),
         steering_rate: Leg::ALL.map(|l| sim.steering_rate(l)),

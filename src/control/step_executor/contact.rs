@@ -196,4 +196,32 @@ mod tests {
         assert_eq!(ex.steps_executed, 1, "{:?}", ex.events);
         assert_eq!(ex.steps_aborted, 0);
     }
+
+    #[test]
+    fn the_base_height_hold_raises_a_sunken_base_up_to_its_cap() {
+        // The keyframes stand the base 0.5 m up; MuJoCo measures it 2 cm lower. With the
+        // gain 2/s the raise after 0.1 s of 10 ms ticks is 2 · 0.02 · 0.1 = 4 mm; 10 cm
+        // low for 0.3 s would ask 6 cm, and it stops at the 4 cm cap; without a
+        // measurement nothing is raised.
+        let keys = step_path();
+        let com = [-0.1, -0.1, 0.4];
+        let contacts = all_contacts(&keys[0].feet);
+        let run = |base_z: Option<f64>, ticks: usize| {
+            let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+            for k in 0..ticks {
+                let mut o = obs(0.01 * (k + 1) as f64, &ex, &contacts, com);
+                o.base_z = base_z;
+                ex.tick(&o, 0.01);
+            }
+            (ex.base_lift, ex.with_offsets(&ex.cmd).base_position[2] - ex.cmd.base_position[2])
+        };
+        let (lift, raised) = run(Some(0.48), 10);
+        assert!((lift - 0.004).abs() < 1e-9, "{lift}");
+        assert!((raised - lift).abs() < 1e-12, "the commanded base carries the raise");
+        let (lift, _) = run(Some(0.40), 30);
+        assert_eq!(lift, config().max_base_lift_m);
+        assert_eq!(run(None, 10).0, 0.0);
+        // A base standing higher than commanded is not lowered.
+        assert_eq!(run(Some(0.52), 10).0, 0.0);
+    }
 }

@@ -30,6 +30,17 @@ pub struct ExecutorConfig {
     pub lift_settle_s: f64,
     /// Gain of the stance wheels' angle hold (speed command per rad of creep), 1/s.
     pub wheel_hold_gain: f64,
+    /// Integral gain of the base height hold during standing manoeuvres, 1/s. The leg
+    /// joints are position servos (the model's kp): under the robot's weight the support
+    /// legs give, most when one foot is lifted and three carry it, and the base sinks
+    /// 1–2 cm below its keyframes. A lifted front leg folds its knee under its hip as the
+    /// foot passes below it, so a sunken base carries that knee into the step's edge the
+    /// plan's leg clearance kept it from. The executor raises its commanded base by the
+    /// integral of the measured shortfall, `lift += gain · (z_commanded − z_measured) · dt`,
+    /// clamped to `[0, max_base_lift_m]`, until the base stands where the keyframes put it.
+    pub base_hold_gain: f64,
+    /// Largest base raise of the height hold, m.
+    pub max_base_lift_m: f64,
     /// Largest stabilising base correction toward the support centroid, m.
     pub max_correction_m: f64,
     /// Time over which a correction increment is applied, s.
@@ -83,6 +94,8 @@ impl ExecutorConfig {
             emergency_margin_m: params.min_lift_margin_m / 2.0,
             lift_settle_s: 0.3,
             wheel_hold_gain: 5.0,
+            base_hold_gain: 2.0,
+            max_base_lift_m: 0.04,
             max_correction_m: 0.06,
             correction_time_s: 0.8,
             max_correction_attempts: 3,
@@ -114,6 +127,9 @@ pub struct Observation {
     pub time: f64,
     /// Measured planar base pose.
     pub base: Pose2,
+    /// Measured base height, m: what the support legs' kinematics (and an IMU) give.
+    /// `None` without it; the base height is then not held (`ExecutorConfig::base_hold_gain`).
+    pub base_z: Option<f64>,
     /// Measured hip, knee, ankle angles per leg, rad.
     pub joints: [[f64; 3]; 4],
     /// Measured steering angles, rad.

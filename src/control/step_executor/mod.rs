@@ -17,6 +17,12 @@
 //!   straight. Stance wheels need no spin (the ankle keeps a planted wheel level); since
 //!   the wheel actuators are velocity servos, a stance pair holds its wheel angles with a
 //!   proportional loop so the foot does not creep under the legs' horizontal forces.
+//! - **Base height** in the standing modes (segments, the lift guard, placing, putting
+//!   down): the leg servos give under the robot's weight and the base sinks 1–2 cm below
+//!   its keyframes, carrying a lifted leg's folded knee toward the edge it passes. The
+//!   commanded base is raised by the integral of the measured shortfall
+//!   ([`ExecutorConfig::base_hold_gain`], capped at [`ExecutorConfig::max_base_lift_m`]);
+//!   driving drops the raise.
 //! - **Before a lift** the support margin measured from MuJoCo (CoM over the wheel
 //!   contacts of the three support legs) must reach [`ExecutorConfig::min_lift_margin_m`]
 //!   (2 cm) plus a reserve for the sag of the compliant support legs when the foot unloads
@@ -131,6 +137,9 @@ pub struct StepExecutor {
     lift_offset: [f64; 3],
     /// Landing offset of the current step.
     landing: [f64; 2],
+    /// The base height hold's raise of the commanded base, m
+    /// (`ExecutorConfig::base_hold_gain`).
+    base_lift: f64,
     last_legs: [[f64; 3]; 4],
     /// Wheel angles the stance wheels hold (None: not holding), rad.
     wheel_hold: [Option<[f64; 2]>; 4],
@@ -178,6 +187,7 @@ impl StepExecutor {
             fading: None,
             lift_offset: [0.0; 3],
             landing: [0.0; 2],
+            base_lift: 0.0,
             last_legs,
             wheel_hold: [None; 4],
             now: 0.0,
@@ -224,6 +234,7 @@ impl StepExecutor {
         let mut q = *p;
         q.base_position[0] += self.correction[0];
         q.base_position[1] += self.correction[1];
+        q.base_position[2] += self.base_lift;
         q.base_rpy[0] += correction_roll(p, self.correction);
         for (f, o) in q.feet.iter_mut().zip(self.foot_offset) {
             for k in 0..3 {
@@ -272,6 +283,7 @@ impl StepExecutor {
 
     /// One control tick of `dt` s.
     pub fn tick(&mut self, obs: &Observation, dt: f64) -> (Command, ExecStatus) {
+        self.hold_base_height(obs, dt);
         let cmd = self.step_mode(obs, dt);
         let status = match &self.mode {
             Mode::Finished => ExecStatus::Finished,
@@ -279,6 +291,26 @@ impl StepExecutor {
             _ => ExecStatus::Running,
         };
         (cmd, status)
+    }
+
+    /// The base height hold (`ExecutorConfig::base_hold_gain`): in the standing modes
+    /// that command postures through [`Self::with_offsets`], integrates how far the
+    /// measured base stands below the commanded one; elsewhere (driving, the return to
+    /// the driving posture, finished) the raise is dropped.
+    fn hold_base_height(&mut self, obs: &Observation, dt: f64) {
+        let standing = matches!(
+            self.mode,
+            Mode::Segment { .. } | Mode::Guard { .. } | Mode::Confirm { .. } | Mode::PutDown { .. }
+        );
+        match obs.base_z {
+            Some(z) if standing => {
+                let shortfall = self.cmd.base_position[2] - z;
+                let c = &self.config;
+                self.base_lift = (self.base_lift + c.base_hold_gain * shortfall * dt)
+                    .clamp(0.0, c.max_base_lift_m);
+            }
+            _ => self.base_lift = 0.0,
+        }
     }
 
     fn step_mode(&mut self, obs: &Observation, dt: f64) -> Command {

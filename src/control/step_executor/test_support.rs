@@ -53,6 +53,7 @@ pub(super) fn obs(
     Observation {
         time,
         base: Pose2::new(0.0, 0.0, 0.0),
+        base_z: None,
         joints: ex.last_legs,
         steering: [0.0; 4],
         steering_rate: [0.0; 4],
