@@ -3,7 +3,7 @@
 //! posture interpolated at the robot's progress along the run. The follower's end of the
 //! run hands over to the next keyframe; too large a cross-track error fails.
 
-use super::{Command, ExecFailure, Mode, Observation, StepExecutor};
+use super::{Command, ExecFailure, Mode, Observation, StepExecutor, planar};
 use crate::control::path_follower::{FollowerStatus, PathFollower};
 use crate::geometry::wrap_angle;
 use crate::motion::kinematics::{Posture, contacts_in_base, interpolate};
@@ -27,13 +27,18 @@ impl StepExecutor {
         let mut rise = 0.0_f64;
         let r = self.robot.wheel_radius;
         let half_track = self.robot.wheel_track / 2.0;
+        let planned = planar(&p);
         for (i, f) in p.feet.iter_mut().enumerate() {
-            let (s, c) = (p.base_rpy[2] + obs.steering[i]).sin_cos();
+            // Where the wheels are: the foot's place under the base as measured, not under
+            // the keyframes' pose, which the robot follows only within the follower's
+            // tolerance (a start off the lattice's headings stands up to 2.8° from it).
+            let [fx, fy] = obs.base.transform(planned.inverse_transform([f[0], f[1]]));
+            let (s, c) = (obs.base.theta + obs.steering[i]).sin_cos();
             let top = f[2] + WHEEL_REST_RANGE_M;
             let rest = [-1.0, 1.0]
                 .iter()
                 .filter_map(|side| {
-                    let (x, y) = (f[0] - side * half_track * s, f[1] + side * half_track * c);
+                    let (x, y) = (fx - side * half_track * s, fy + side * half_track * c);
                     self.ground.wheel_rest_height(x, y, r, top)
                 })
                 .fold(None, |a: Option<f64>, z| Some(a.map_or(z, |a| a.max(z))));
@@ -108,5 +113,36 @@ impl StepExecutor {
         });
         let wheels = self.config.wheels.commands(&self.robot, out.twist, &feet, &obs.steering);
         Command { legs, wheels: self.with_steer_rate(wheels, obs) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::control::step_executor::StepExecutor;
+    use crate::control::step_executor::test_support::{config, obs, robot, standing, step_path};
+    use crate::geometry::Pose2;
+    use crate::terrain::HeightMap;
+
+    #[test]
+    fn wheels_rest_on_the_ground_under_the_measured_base_not_the_keyframes() {
+        // A 4 cm bump under the front-left foot's keyframe position (hip at (0.35, 0.32),
+        // the bump covering x ∈ [0.25, 0.45], y ∈ [0.2, 0.45]). With the base measured where
+        // the keyframes put it, the front-left wheels rest on the bump and the base rises
+        // 4 cm; with the base measured 0.3 m behind, the wheels stand on the floor and
+        // nothing rises.
+        let bump = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |i, j| {
+            let (x, y) = (-2.0 + (i as f64 + 0.5) * 0.025, -2.0 + (j as f64 + 0.5) * 0.025);
+            if (0.25..0.45).contains(&x) && (0.2..0.45).contains(&y) { 0.04 } else { 0.0 }
+        })
+        .unwrap();
+        let ex = StepExecutor::new(&robot(), config(), step_path(), bump);
+        let p = standing();
+        let mut o = obs(0.0, &ex, &[], [0.0; 3]);
+        let rise = |o: &crate::control::step_executor::Observation| {
+            ex.on_wheel_rest_heights(p, o).base_position[2] - p.base_position[2]
+        };
+        assert!((rise(&o) - 0.04).abs() < 1e-9, "{}", rise(&o));
+        o.base = Pose2::new(-0.3, 0.0, 0.0);
+        assert!(rise(&o).abs() < 1e-9, "{}", rise(&o));
     }
 }
