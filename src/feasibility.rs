@@ -25,7 +25,7 @@
 
 use crate::cost::CostMaps;
 use crate::geometry::Pose2;
-use crate::motion::kinematics::{self, Posture, PostureError, solve_legs};
+use crate::motion::kinematics::{self, Posture, PostureError, solve_chains};
 use crate::motion::standing::{self, StandingRule};
 use crate::params::Params;
 use crate::robot::RobotDescription;
@@ -135,17 +135,17 @@ impl DrivingCheck {
         maps: &CostMaps,
         leg_terrain: &HeightMap,
     ) -> Result<[[f64; 3]; 4], Infeasible> {
-        let joints = solve_legs(&self.robot, p, self.rule.reach_margin_m)?;
-        self.rule.legs_clear(&self.robot, leg_terrain, p, &joints)?;
-        self.body_clear(p, maps)?;
-        let com = standing::com_estimate(&self.robot, p)?;
+        let legs = solve_chains(&self.robot, p, self.rule.reach_margin_m)?;
+        self.rule.legs_clear(&self.robot, leg_terrain, &legs)?;
+        self.body_clear_in(p, &legs.frame.rotation, maps)?;
+        let com = standing::solved_com_estimate(&self.robot, p, &legs);
         let support: Vec<[f64; 2]> =
             (0..4).filter(|&i| p.contact[i]).map(|i| [p.feet[i][0], p.feet[i][1]]).collect();
         let margin_m = stability_margin(&support, com);
         if margin_m < self.min_margin_m {
             return Err(Infeasible::Margin { margin_m, required_m: self.min_margin_m });
         }
-        Ok(joints)
+        Ok(legs.joints())
     }
 
     /// Whether the base's underside (at hip level, `RobotDescription::base_bottom_z`)
@@ -156,11 +156,20 @@ impl DrivingCheck {
     /// # Errors
     /// [`Infeasible::BodyCollision`], or unknown terrain under a circle.
     pub fn body_clear(&self, p: &Posture, maps: &CostMaps) -> Result<(), Infeasible> {
-        let r = kinematics::rotation(p.base_rpy);
+        self.body_clear_in(p, &kinematics::rotation(p.base_rpy), maps)
+    }
+
+    /// [`Self::body_clear`] with the base rotation `r` of `p` given.
+    fn body_clear_in(
+        &self,
+        p: &Posture,
+        r: &[[f64; 3]; 3],
+        maps: &CostMaps,
+    ) -> Result<(), Infeasible> {
         let z_under = self.robot.hips[0][2] + self.robot.base_bottom_z;
         let hm = maps.heights();
         for cx in self.robot.base_circle_centres_x(self.circle_radius_m) {
-            let w = kinematics::apply(&r, p.base_position, [cx, 0.0, z_under]);
+            let w = kinematics::apply(r, p.base_position, [cx, 0.0, z_under]);
             let Some((i, j)) = hm.cell_of(w[0], w[1]) else {
                 return Err(Infeasible::UnknownTerrain { x: w[0], y: w[1] });
             };

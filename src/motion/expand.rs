@@ -59,9 +59,11 @@ use super::CenterOfMassModel;
 use super::keyframe::{DetailedPath, Keyframe, Phase};
 use super::kinematics;
 use super::kinematics::PostureError;
-use super::kinematics::{Evaluation, Posture, contacts_in_base, evaluate, interpolate, rotation};
+use super::kinematics::{
+    Evaluation, Posture, contacts_in, evaluate, evaluate_legs, interpolate, rotation, solve_chains,
+};
 use super::roll::roll_for_lateral_com;
-use super::standing::{StandingRule, StepStance, base_z};
+use super::standing::{StandingRule, StepStance, base_z_in};
 use crate::cost::CostMaps;
 use crate::feasibility::{DrivingCheck, Infeasible};
 use crate::geometry::{Pose2, wrap_angle};
@@ -296,15 +298,15 @@ impl<'a> Expander<'a> {
         let r = rotation(rpy);
         let mut p = Posture { base_position: [xy[0], xy[1], 0.0], base_rpy: rpy, feet, contact };
         for _ in 0..3 {
-            p.base_position[2] = base_z(self.robot, &ground, rpy, height);
-            let local = contacts_in_base(self.robot, &p);
+            p.base_position[2] = base_z_in(self.robot, &ground, &r, height);
+            let local = contacts_in(self.robot, &r, &p);
             let n = contact.iter().filter(|&&c| c).count().max(1) as f64;
             let m = (0..4).filter(|&i| contact[i]).map(|i| local[i][1]).sum::<f64>() / n;
             for (b, row) in p.base_position.iter_mut().zip(&r) {
                 *b += row[1] * m;
             }
         }
-        let local = contacts_in_base(self.robot, &p);
+        let local = contacts_in(self.robot, &r, &p);
         for i in 0..4 {
             if !contact[i] {
                 let h = self.robot.hips[i];
@@ -331,8 +333,8 @@ impl<'a> Expander<'a> {
     }
 
     fn com_of(&mut self, p: &Posture) -> Result<[f64; 3], String> {
-        evaluate(self.robot, self.model, p, self.o.standing.reach_margin_m)
-            .map(|e| e.com)
+        solve_chains(self.robot, p, self.o.standing.reach_margin_m)
+            .map(|legs| self.model.com_of_solved(&legs))
             .map_err(|e| e.to_string())
     }
 
@@ -340,9 +342,10 @@ impl<'a> Expander<'a> {
     /// terrain, and the stability margin.
     fn check_posture(&mut self, p: &Posture) -> Result<Evaluation, Infeasible> {
         let o = self.o;
-        let e = evaluate(self.robot, self.model, p, o.standing.reach_margin_m).and_then(|e| {
-            o.standing.legs_clear(self.robot, self.maps.leg_terrain(), p, &e.joints).map(|()| e)
-        })?;
+        // The clearance before the CoM: a posture it rejects needs none.
+        let legs = solve_chains(self.robot, p, o.standing.reach_margin_m)?;
+        o.standing.legs_clear(self.robot, self.maps.leg_terrain(), &legs)?;
+        let e = evaluate_legs(self.robot, self.model, p, &legs);
         if e.margin < o.min_margin_m {
             return Err(Infeasible::Margin { margin_m: e.margin, required_m: o.min_margin_m });
         }

@@ -10,7 +10,7 @@
 
 use super::CenterOfMassModel;
 use crate::geometry::{Pose2, norm2};
-use crate::robot::ik::{IkError, ankle_of_contact, leg_ik};
+use crate::robot::ik::{IkError, LegChain, leg_chain, leg_ik, world_down};
 use crate::robot::{Leg, RobotDescription};
 use crate::stability::{convex_hull, stability_margin};
 use serde::Serialize;
@@ -118,11 +118,59 @@ pub fn support_centroid(points: &[[f64; 2]]) -> Option<[f64; 2]> {
     Some([hull.iter().map(|p| p[0]).sum::<f64>() / n, hull.iter().map(|p| p[1]).sum::<f64>() / n])
 }
 
+/// The trigonometry of a base orientation, computed once for every check of a posture
+/// (or of postures sharing the orientation, as the heights the standing rule tries).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaseFrame {
+    /// Base roll, pitch, yaw, rad.
+    pub rpy: [f64; 3],
+    /// [`rotation`]`(rpy)`.
+    pub rotation: [[f64; 3]; 3],
+    /// World down in the legs' sagittal planes, [`world_down`]`(pitch)`.
+    pub down: [f64; 2],
+}
+
+impl BaseFrame {
+    /// The frame of a base at `rpy`.
+    pub fn new(rpy: [f64; 3]) -> Self {
+        Self { rpy, rotation: rotation(rpy), down: world_down(rpy[1]) }
+    }
+}
+
+/// The legs of a posture solved ([`solve_chains`]), with what the checks after the IK
+/// reuse: the base frame, the contacts in it and each leg's chain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolvedLegs {
+    /// Base origin in the world, m.
+    pub base_position: [f64; 3],
+    /// The base frame.
+    pub frame: BaseFrame,
+    /// Per leg: the contact point (x', y', z') relative to the hip in the base frame, m.
+    pub contacts: [[f64; 3]; 4],
+    /// Per leg: joint angles, knee and ankle.
+    pub chains: [LegChain; 4],
+}
+
+impl SolvedLegs {
+    /// Joint angles (hip, knee, ankle) per leg, rad.
+    pub fn joints(&self) -> [[f64; 3]; 4] {
+        self.chains.map(|c| c.joints)
+    }
+}
+
 /// Per leg: the contact point (x', y', z') relative to the hip in the base frame.
 pub fn contacts_in_base(robot: &RobotDescription, p: &Posture) -> [[f64; 3]; 4] {
-    let r = rotation(p.base_rpy);
+    contacts_in(robot, &rotation(p.base_rpy), p)
+}
+
+/// [`contacts_in_base`] with the base rotation `r` of `p` given.
+pub(crate) fn contacts_in(
+    robot: &RobotDescription,
+    r: &[[f64; 3]; 3],
+    p: &Posture,
+) -> [[f64; 3]; 4] {
     std::array::from_fn(|i| {
-        let b = apply_inverse(&r, p.base_position, p.feet[i]);
+        let b = apply_inverse(r, p.base_position, p.feet[i]);
         let h = robot.hips[i];
         [b[0] - h[0], b[1] - h[1], b[2] - h[2]]
     })
@@ -144,24 +192,58 @@ pub fn solve_legs(
     p: &Posture,
     reach_margin: f64,
 ) -> Result<[[f64; 3]; 4], PostureError> {
-    let local = contacts_in_base(robot, p);
-    let pitch = p.base_rpy[1];
+    solve_chains(robot, p, reach_margin).map(|s| s.joints())
+}
+
+/// [`solve_legs`] with the base frame, contacts and chains it solves through, so that
+/// the checks after it compute none of them again.
+///
+/// # Errors
+/// [`PostureError`] as [`solve_legs`].
+pub fn solve_chains(
+    robot: &RobotDescription,
+    p: &Posture,
+    reach_margin: f64,
+) -> Result<SolvedLegs, PostureError> {
+    solve_chains_in(robot, &BaseFrame::new(p.base_rpy), p, reach_margin)
+}
+
+/// [`solve_chains`] with the base frame of `p` given (`BaseFrame::new(p.base_rpy)`,
+/// shared by postures of one orientation).
+///
+/// # Errors
+/// [`PostureError`] as [`solve_legs`].
+pub fn solve_chains_in(
+    robot: &RobotDescription,
+    frame: &BaseFrame,
+    p: &Posture,
+    reach_margin: f64,
+) -> Result<SolvedLegs, PostureError> {
+    debug_assert!(
+        frame.rpy.map(f64::to_bits) == p.base_rpy.map(f64::to_bits),
+        "frame {:?} for a base at {:?}",
+        frame.rpy,
+        p.base_rpy
+    );
+    let local = contacts_in(robot, &frame.rotation, p);
+    let pitch = frame.rpy[1];
+    let below = robot.foot_length + robot.wheel_radius;
     let reach = robot.thigh_length + robot.shin_length;
-    let mut joints = [[0.0; 3]; 4];
+    let mut chains = [LegChain { joints: [0.0; 3], knee: [0.0; 2], ankle: [0.0; 2] }; 4];
     for leg in Leg::ALL {
         let i = leg.index();
         let c = local[i];
         if p.contact[i] && c[1].abs() > MAX_LATERAL_MISMATCH_M {
             return Err(PostureError::Lateral { leg, offset: c[1] });
         }
-        let ankle = ankle_of_contact(robot, [c[0], c[2]], pitch);
+        let ankle = [c[0] - below * frame.down[0], c[2] - below * frame.down[1]];
         let distance = norm2(ankle[0], ankle[1]);
         if distance > reach - reach_margin {
             return Err(PostureError::ReachMargin { leg, distance, margin: reach_margin });
         }
-        joints[i] = leg_ik(robot, leg, [c[0], c[2]], pitch)?;
+        chains[i] = leg_chain(robot, leg, [c[0], c[2]], pitch, frame.down)?;
     }
-    Ok(joints)
+    Ok(SolvedLegs { base_position: p.base_position, frame: *frame, contacts: local, chains })
 }
 
 /// Solves the legs of `p` ([`solve_legs`]), computes the CoM with `model` and the
@@ -175,16 +257,27 @@ pub fn evaluate(
     p: &Posture,
     reach_margin: f64,
 ) -> Result<Evaluation, PostureError> {
-    let joints = solve_legs(robot, p, reach_margin)?;
-    let hips = hips_in_world(robot, p);
-    let leg_heights = std::array::from_fn(|i| hips[i][2] - p.feet[i][2]);
-    let com = model.com(p.base_position, p.base_rpy, &joints);
+    Ok(evaluate_legs(robot, model, p, &solve_chains(robot, p, reach_margin)?))
+}
+
+/// [`evaluate`] of posture `p` with its legs solved (`legs`, [`solve_chains`]).
+pub fn evaluate_legs(
+    robot: &RobotDescription,
+    model: &mut dyn CenterOfMassModel,
+    p: &Posture,
+    legs: &SolvedLegs,
+) -> Evaluation {
+    let joints = legs.joints();
+    let r = &legs.frame.rotation;
+    let leg_heights =
+        std::array::from_fn(|i| apply(r, p.base_position, robot.hips[i])[2] - p.feet[i][2]);
+    let com = model.com_of_solved(legs);
     let support: Vec<[f64; 2]> =
         (0..4).filter(|&i| p.contact[i]).map(|i| [p.feet[i][0], p.feet[i][1]]).collect();
     let margin = stability_margin(&support, [com[0], com[1]]);
     let centroid_distance =
         support_centroid(&support).map_or(f64::INFINITY, |c| norm2(c[0] - com[0], c[1] - com[1]));
-    Ok(Evaluation { joints, leg_heights, com, margin, centroid_distance })
+    Evaluation { joints, leg_heights, com, margin, centroid_distance }
 }
 
 /// Base pitch for feet `feet` under a base heading `yaw` (Sec. VI-B): `pitch_fraction` of
@@ -336,6 +429,65 @@ mod tests {
         for k in 0..3 {
             assert!((back[k] - p[k]).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn solved_chains_by_hand() {
+        // Level base, every foot 0.45 m under its hip: the contacts straight down, the
+        // ankles 0.27 m below the hips, the knees halfway down and √(0.25² − 0.135²) to
+        // the body centre's side (front knees back, rear knees forward).
+        let robot = RobotDescription::reference();
+        let feet = robot.hips.map(|h| [h[0], h[1], h[2] - 0.45]);
+        let p = Posture { base_position: [0.0; 3], base_rpy: [0.0; 3], feet, contact: [true; 4] };
+        let legs = solve_chains(&robot, &p, 0.002).unwrap();
+        assert_eq!(legs.frame, BaseFrame::new([0.0; 3]));
+        assert_eq!(legs.frame.down, [0.0, -1.0]);
+        assert_eq!(legs.joints(), solve_legs(&robot, &p, 0.002).unwrap());
+        let side = (0.25f64 * 0.25 - 0.135 * 0.135).sqrt();
+        for leg in Leg::ALL {
+            let (i, c) = (leg.index(), legs.chains[leg.index()]);
+            assert!(
+                legs.contacts[i].iter().zip([0.0, 0.0, -0.45]).all(|(a, b)| (a - b).abs() < 1e-12)
+            );
+            assert!(c.ankle[0].abs() < 1e-12 && (c.ankle[1] + 0.27).abs() < 1e-12, "{c:?}");
+            let x = if leg.is_front() { -side } else { side };
+            assert!((c.knee[0] - x).abs() < 1e-12 && (c.knee[1] + 0.135).abs() < 1e-12, "{c:?}");
+        }
+        // The frame of a rolled, pitched, turned base is the rotation and the sagittal down:
+        // nose up by 0.2, world down points back in the base frame, (−sin 0.2, −cos 0.2).
+        let f = BaseFrame::new([0.1, -0.2, 0.7]);
+        assert_eq!(f.rotation, rotation([0.1, -0.2, 0.7]));
+        assert!(
+            (f.down[0] + 0.2f64.sin()).abs() < 1e-15 && (f.down[1] + 0.2f64.cos()).abs() < 1e-15
+        );
+        // The same errors as solve_legs: a foot out of reach.
+        let mut far = p;
+        far.feet[3][0] -= 1.0;
+        assert!(matches!(
+            solve_chains(&robot, &far, 0.002),
+            Err(PostureError::ReachMargin { leg: Leg::RearRight, .. })
+        ));
+    }
+
+    #[test]
+    fn evaluate_legs_is_evaluate() {
+        // A pitched, rolled posture with one foot lifted: the evaluation from the solved
+        // legs is the one evaluate gives, leg heights the hips above the feet.
+        let robot = RobotDescription::reference();
+        let mut p =
+            driving_posture(&robot, &Pose2::new(0.3, -0.2, 0.4), 0.35, 0.7, |x, _| Some(0.1 * x))
+                .unwrap();
+        p.base_rpy[0] = 0.02;
+        p.contact[1] = false;
+        let mut model = crate::motion::LumpedMassModel::momaro_like(&robot);
+        let legs = solve_chains(&robot, &p, 0.002).unwrap();
+        let e = evaluate_legs(&robot, &mut model, &p, &legs);
+        assert_eq!(e, evaluate(&robot, &mut model, &p, 0.002).unwrap());
+        let hips = hips_in_world(&robot, &p);
+        for (i, hip) in hips.iter().enumerate() {
+            assert_eq!(e.leg_heights[i], hip[2] - p.feet[i][2]);
+        }
+        assert_eq!(contacts_in(&robot, &rotation(p.base_rpy), &p), contacts_in_base(&robot, &p));
     }
 
     #[test]

@@ -40,6 +40,13 @@ pub trait CenterOfMassModel {
         base_rpy: [f64; 3],
         legs: &[[f64; 3]; 4],
     ) -> [f64; 3];
+
+    /// The CoM of a posture whose legs [`kinematics::solve_chains`] has solved: what
+    /// [`Self::com`] gives for its base and joint angles. A model that can use the solved
+    /// chain (the planner's lumped estimate) overrides it and saves recomputing it.
+    fn com_of_solved(&mut self, legs: &kinematics::SolvedLegs) -> [f64; 3] {
+        self.com(legs.base_position, legs.frame.rpy, &legs.joints())
+    }
 }
 
 /// An analytic CoM model for tests and quick estimates: a body point mass fixed in the base
@@ -101,5 +108,28 @@ impl CenterOfMassModel for LumpedMassModel {
             add(world(axle), self.wheel_mass);
         }
         if mass > 0.0 { sum.map(|v| v / mass) } else { base_position }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn com_of_solved_defaults_to_the_angles() {
+        // A model that knows only joint angles gives, for solved legs, its CoM of their
+        // angles: by hand, level base and feet under the hips 0.45 m down, the knees
+        // mirror each other front to rear and the body's 0.15 m lifts the CoM to
+        // 34 · 0.15 / 58 above the knee and axle masses' mean height.
+        let robot = RobotDescription::reference();
+        let feet = robot.hips.map(|h| [h[0], h[1], h[2] - 0.45]);
+        let p = Posture { base_position: [0.0; 3], base_rpy: [0.0; 3], feet, contact: [true; 4] };
+        let legs = kinematics::solve_chains(&robot, &p, 0.0).unwrap();
+        let mut model = LumpedMassModel::momaro_like(&robot);
+        let c = model.com_of_solved(&legs);
+        assert_eq!(c, model.com([0.0; 3], [0.0; 3], &legs.joints()));
+        // Knees at z' = −0.05 − 0.135, axles at −0.05 − 0.45 + 0.08.
+        let z = (34.0 * 0.15 + 4.0 * 3.3 * -0.185 + 4.0 * 2.7 * -0.42) / 58.0;
+        assert!(c[0].abs() < 1e-12 && c[1].abs() < 1e-12 && (c[2] - z).abs() < 1e-12, "{c:?}");
     }
 }

@@ -20,11 +20,14 @@
 //!   clear it), and its foot must also be reachable at the swing height above both ends.
 
 use super::CenterOfMassModel;
-use super::kinematics::{Posture, PostureError, apply, pitch_from_feet, rotation, solve_legs};
+use super::kinematics::{
+    BaseFrame, Posture, PostureError, SolvedLegs, apply, contacts_in, pitch_from_feet, rotation,
+    solve_chains, solve_chains_in,
+};
 use crate::geometry::{Pose2, norm2};
 use crate::params::Params;
 use crate::robot::RobotDescription;
-use crate::robot::ik::{knee_and_ankle, leg_fk, world_down};
+use crate::robot::ik::{LegChain, knee_and_ankle, leg_fk};
 use crate::terrain::HeightMap;
 
 /// The parameters of the rule.
@@ -84,7 +87,7 @@ impl StandingRule {
         (0..=n).map(move |k| top - k as f64 * step)
     }
 
-    /// Whether every thigh and shin of posture `p` (joint angles `joints`) keeps
+    /// Whether every thigh and shin of a posture (its legs solved, `legs`) keeps
     /// `leg_clearance_m` above `terrain` (heights dilated by the legs' width, see
     /// `CostMaps::leg_terrain`) at points a quarter segment (6.25 cm) apart along it: a
     /// lowered base must not fold a knee onto a step.
@@ -95,14 +98,13 @@ impl StandingRule {
         &self,
         robot: &RobotDescription,
         terrain: &HeightMap,
-        p: &Posture,
-        joints: &[[f64; 3]; 4],
+        legs: &SolvedLegs,
     ) -> Result<(), PostureError> {
-        let r = rotation(p.base_rpy);
+        let r = &legs.frame.rotation;
         for leg in crate::robot::Leg::ALL {
             let i = leg.index();
             let h = robot.hips[i];
-            let [knee, ankle] = knee_and_ankle(robot, joints[i]);
+            let LegChain { knee, ankle, .. } = legs.chains[i];
             let chain = [
                 [h[0], h[2]],
                 [h[0] + knee[0], h[2] + knee[1]],
@@ -117,7 +119,7 @@ impl StandingRule {
                         h[1],
                         seg[0][1] + (seg[1][1] - seg[0][1]) * t,
                     ];
-                    let w = apply(&r, p.base_position, b);
+                    let w = apply(r, legs.base_position, b);
                     let Some(top) = terrain.height_at_cell(w[0], w[1]) else { continue };
                     if w[2] - top < self.leg_clearance_m {
                         return Err(PostureError::LegCollision { leg, clearance: w[2] - top });
@@ -172,16 +174,17 @@ impl StandingRule {
     ) -> Result<(Posture, f64), PostureError> {
         let pitch = self.pitch(&feet, yaw);
         let ground = feet.map(|f| f[2]);
-        let probe = ReachProbe::new(robot, &feet, [true; 4], xy, [0.0, pitch, yaw], &ground, self);
+        let frame = BaseFrame::new([0.0, pitch, yaw]);
+        let probe = ReachProbe::new(robot, &feet, [true; 4], xy, &frame, &ground, self);
         let mut last = None;
         for h in self.heights() {
             if let Err(e) = probe.distances_ok(h) {
                 last = Some(e);
                 continue;
             }
-            let p = level_posture(robot, feet, [true; 4], xy, [0.0, pitch, yaw], h, ground);
-            match solve_legs(robot, &p, self.reach_margin_m)
-                .and_then(|q| self.legs_clear(robot, terrain, &p, &q))
+            let p = level_posture_in(robot, feet, [true; 4], xy, &frame, h, ground);
+            match solve_chains_in(robot, &frame, &p, self.reach_margin_m)
+                .and_then(|legs| self.legs_clear(robot, terrain, &legs))
             {
                 Ok(()) => return Ok((p, h)),
                 Err(e) => last = Some(e),
@@ -210,9 +213,10 @@ impl StandingRule {
         yaw: f64,
     ) -> impl Iterator<Item = f64> + use<'a> {
         let StepStance { post, pitch, ground } = self.step_stance(&pre, leg, post_foot, yaw);
-        let rpy = [0.0, pitch, yaw];
-        let probe =
-            |feet: &[[f64; 3]; 4]| ReachProbe::new(robot, feet, [true; 4], xy, rpy, &ground, self);
+        let frame = BaseFrame::new([0.0, pitch, yaw]);
+        let probe = |feet: &[[f64; 3]; 4]| {
+            ReachProbe::new(robot, feet, [true; 4], xy, &frame, &ground, self)
+        };
         let mut variants = vec![pre, post];
         let mut probes: Vec<ReachProbe> = variants.iter().map(probe).collect();
         // The swing height scans the terrain around the path, the dearest part: only
@@ -271,9 +275,9 @@ impl StandingRule {
                 return false;
             }
             let failed = variants.iter().position(|feet| {
-                let p = level_posture(robot, *feet, [true; 4], xy, rpy, h, ground);
-                solve_legs(robot, &p, self.reach_margin_m)
-                    .and_then(|q| self.legs_clear(robot, leg_terrain, &p, &q))
+                let p = level_posture_in(robot, *feet, [true; 4], xy, &frame, h, ground);
+                solve_chains_in(robot, &frame, &p, self.reach_margin_m)
+                    .and_then(|legs| self.legs_clear(robot, leg_terrain, &legs))
                     .is_err()
             });
             if let Some(k) = failed {
@@ -321,10 +325,10 @@ const SWING_SAMPLE_M: f64 = 0.05;
 /// the motion generator's sample spacing (`motion::expand`).
 const SWING_FINE_M: f64 = 0.01;
 
-/// The cheap part of [`solve_legs`] for one set of feet at every height of the rule: the
-/// rotation and the feet in the base frame are computed once; lowering the base by δ
-/// moves every foot by δ·Rᵀe_z in the base frame, so each height costs four distance
-/// checks. The joint-limit part stays with [`solve_legs`].
+/// The cheap part of [`super::kinematics::solve_legs`] for one set of feet at every
+/// height of the rule: the rotation and the feet in the base frame are computed once;
+/// lowering the base by δ moves every foot by δ·Rᵀe_z in the base frame, so each height
+/// costs four distance checks. The joint-limit part stays with `solve_legs`.
 struct ReachProbe {
     /// Feet relative to their hips in the base frame at `h0`.
     local0: [[f64; 3]; 4],
@@ -345,17 +349,16 @@ impl ReachProbe {
         feet: &[[f64; 3]; 4],
         contact: [bool; 4],
         xy: [f64; 2],
-        rpy: [f64; 3],
+        frame: &BaseFrame,
         ground: &[f64; 4],
         rule: &StandingRule,
     ) -> Self {
         let h0 = rule.leg_height_m;
-        let p = level_posture(robot, *feet, contact, xy, rpy, h0, *ground);
-        let r = rotation(rpy);
+        let p = level_posture_in(robot, *feet, contact, xy, frame, h0, *ground);
+        let (r, down) = (&frame.rotation, frame.down);
         let below = robot.foot_length + robot.wheel_radius;
-        let down = world_down(rpy[1]);
         Self {
-            local0: super::kinematics::contacts_in_base(robot, &p),
+            local0: contacts_in(robot, r, &p),
             up: [r[2][0], r[2][1], r[2][2]],
             h0,
             ankle: [-below * down[0], -below * down[1]],
@@ -413,7 +416,8 @@ impl ReachProbe {
     }
 
     /// Whether every leg's hip-to-ankle distance at leg height `h` leaves the reach
-    /// margin, and every foot in contact lies on its leg plane (as [`solve_legs`]).
+    /// margin, and every foot in contact lies on its leg plane (as
+    /// [`super::kinematics::solve_legs`]).
     fn distances_ok(&self, h: f64) -> Result<(), PostureError> {
         let d = self.h0 - h;
         for leg in crate::robot::Leg::ALL {
@@ -446,9 +450,14 @@ impl ReachProbe {
 /// # Errors
 /// [`PostureError`] if a leg cannot reach its foot.
 pub fn com_estimate(robot: &RobotDescription, p: &Posture) -> Result<[f64; 2], PostureError> {
-    let joints = solve_legs(robot, p, 0.0)?;
-    let c = lumped_com(robot, p.base_position, p.base_rpy, &joints, &p.feet);
-    Ok([c[0], c[1]])
+    Ok(solved_com_estimate(robot, p, &solve_chains(robot, p, 0.0)?))
+}
+
+/// [`com_estimate`] of posture `p` with its legs solved (`legs`, [`solve_chains`] with
+/// any reach margin: the chains do not depend on it).
+pub fn solved_com_estimate(robot: &RobotDescription, p: &Posture, legs: &SolvedLegs) -> [f64; 2] {
+    let c = lumped_com(robot, legs.base_position, &legs.frame.rotation, &legs.chains, &p.feet);
+    [c[0], c[1]]
 }
 
 /// [`com_estimate`]'s lumped masses as a [`CenterOfMassModel`]: the motion generator's
@@ -476,28 +485,45 @@ impl CenterOfMassModel for EstimatedCom<'_> {
             let contact = apply(&r, base_position, [h[0] + c[0], h[1], h[2] + c[1]]);
             [contact[0], contact[1], contact[2] + rb.wheel_radius]
         });
-        lumped_com(rb, base_position, base_rpy, legs, &axles)
+        let chains = legs.map(|q| {
+            let [knee, ankle] = knee_and_ankle(rb, q);
+            LegChain { joints: q, knee, ankle }
+        });
+        lumped_com(rb, base_position, &r, &chains, &axles)
+    }
+
+    /// [`Self::com`] from the solved chains: the knees and ankles the IK solved for, and
+    /// the axles straight above the contacts it solved them for (where the forward
+    /// kinematics of the angles puts them, to rounding).
+    fn com_of_solved(&mut self, legs: &SolvedLegs) -> [f64; 3] {
+        let rb = self.robot;
+        let r = &legs.frame.rotation;
+        let axles: [[f64; 3]; 4] = std::array::from_fn(|i| {
+            let (h, c) = (rb.hips[i], legs.contacts[i]);
+            let contact = apply(r, legs.base_position, [h[0] + c[0], h[1], h[2] + c[2]]);
+            [contact[0], contact[1], contact[2] + rb.wheel_radius]
+        });
+        lumped_com(rb, legs.base_position, r, &legs.chains, &axles)
     }
 }
 
-/// The lumped-mass CoM (world, m): the body at its CoM, thighs and shins at their
-/// midpoints for joint angles `joints`, each foot's mass at `feet`.
+/// The lumped-mass CoM (world, m) of a base at `base_position` rotated by `r`: the body
+/// at its CoM, thighs and shins at the midpoints of `chains`, each foot's mass at `feet`.
 fn lumped_com(
     robot: &RobotDescription,
     base_position: [f64; 3],
-    base_rpy: [f64; 3],
-    joints: &[[f64; 3]; 4],
+    r: &[[f64; 3]; 3],
+    chains: &[LegChain; 4],
     feet: &[[f64; 3]; 4],
 ) -> [f64; 3] {
-    let r = rotation(base_rpy);
-    let world = |b: [f64; 3]| apply(&r, base_position, b);
+    let world = |b: [f64; 3]| apply(r, base_position, b);
     let body = world(robot.body_com);
     let [m_thigh, m_shin, m_foot] = robot.leg_segment_masses;
     let mut c = body.map(|v| robot.body_mass * v);
     let mut total = robot.body_mass;
-    for (i, q) in joints.iter().enumerate() {
+    for (i, chain) in chains.iter().enumerate() {
         let h = robot.hips[i];
-        let [knee, ankle] = knee_and_ankle(robot, *q);
+        let LegChain { knee, ankle, .. } = *chain;
         let thigh = world([h[0] + knee[0] / 2.0, h[1], h[2] + knee[1] / 2.0]);
         let shin =
             world([h[0] + (knee[0] + ankle[0]) / 2.0, h[1], h[2] + (knee[1] + ankle[1]) / 2.0]);
@@ -517,7 +543,16 @@ fn lumped_com(
 /// Base origin height for the base at `rpy` such that the hip over the highest of `ground`
 /// (per leg, m) stands `height` above it and no hip stands lower above its ground.
 pub fn base_z(robot: &RobotDescription, ground: &[f64; 4], rpy: [f64; 3], height: f64) -> f64 {
-    let r = rotation(rpy);
+    base_z_in(robot, ground, &rotation(rpy), height)
+}
+
+/// [`base_z`] with the base rotation `r` given.
+pub(crate) fn base_z_in(
+    robot: &RobotDescription,
+    ground: &[f64; 4],
+    r: &[[f64; 3]; 3],
+    height: f64,
+) -> f64 {
     (0..4)
         .map(|i| {
             let h = robot.hips[i];
@@ -537,16 +572,29 @@ pub fn level_posture(
     height: f64,
     ground: [f64; 4],
 ) -> Posture {
-    let z = base_z(robot, &ground, rpy, height);
-    let mut p = Posture { base_position: [xy[0], xy[1], z], base_rpy: rpy, feet, contact };
+    level_posture_in(robot, feet, contact, xy, &BaseFrame::new(rpy), height, ground)
+}
+
+/// [`level_posture`] with the base frame given.
+fn level_posture_in(
+    robot: &RobotDescription,
+    feet: [[f64; 3]; 4],
+    contact: [bool; 4],
+    xy: [f64; 2],
+    frame: &BaseFrame,
+    height: f64,
+    ground: [f64; 4],
+) -> Posture {
+    let r = &frame.rotation;
+    let z = base_z_in(robot, &ground, r, height);
+    let mut p = Posture { base_position: [xy[0], xy[1], z], base_rpy: frame.rpy, feet, contact };
     if contact.iter().any(|c| !c) {
-        let r = rotation(rpy);
-        let local = super::kinematics::contacts_in_base(robot, &p);
+        let local = contacts_in(robot, r, &p);
         for i in 0..4 {
             if !contact[i] {
                 let h = robot.hips[i];
                 p.feet[i] =
-                    apply(&r, p.base_position, [local[i][0] + h[0], h[1], local[i][2] + h[2]]);
+                    apply(r, p.base_position, [local[i][0] + h[0], h[1], local[i][2] + h[2]]);
             }
         }
     }
@@ -556,6 +604,7 @@ pub fn level_posture(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::motion::kinematics::solve_legs;
 
     fn rule() -> StandingRule {
         StandingRule::from_params(&Params::default())
@@ -670,10 +719,11 @@ mod tests {
                 ];
                 let ground = feet.map(|f| f[2]);
                 let rpy = [0.0, r.pitch(&feet, 0.3), 0.3];
+                let frame = BaseFrame::new(rpy);
                 let (s3, c3) = 0.3f64.sin_cos();
                 let world = feet.map(|f| [c3 * f[0] - s3 * f[1], s3 * f[0] + c3 * f[1], f[2]]);
                 let probe =
-                    ReachProbe::new(&robot, &world, [true; 4], [0.0, 0.0], rpy, &ground, &r);
+                    ReachProbe::new(&robot, &world, [true; 4], [0.0, 0.0], &frame, &ground, &r);
                 // The analytic window holds every height that passes (checked on a
                 // 1 mm grid, through and past the rule's heights) and nothing 2 µm
                 // inside its ends fails.
@@ -725,6 +775,52 @@ mod tests {
     }
 
     #[test]
+    fn the_estimate_from_solved_legs_is_the_estimate_from_angles() {
+        // Level base, feet under the hips 0.45 m down: by hand (as above) the lumped CoM
+        // lies at x = 0.04/58, whether from the solved chains or the angles.
+        let robot = RobotDescription::reference();
+        let feet = robot.hips.map(|h| [h[0], h[1], h[2] - 0.45]);
+        let p = Posture { base_position: [0.0; 3], base_rpy: [0.0; 3], feet, contact: [true; 4] };
+        let legs = solve_chains(&robot, &p, 0.002).unwrap();
+        let c = solved_com_estimate(&robot, &p, &legs);
+        assert!((c[0] - 0.04 / 58.0).abs() < 1e-12 && c[1].abs() < 1e-12, "{c:?}");
+        // Over pitched, rolled, turned postures with a foot stretched back: the model's
+        // CoM from the chains is the one from the angles (knees, ankles and axles by the
+        // forward kinematics) to rounding.
+        let mut model = EstimatedCom { robot: &robot };
+        for (k, rpy) in [[0.0, 0.0, 0.0], [0.03, -0.2, 0.5], [-0.05, 0.25, -2.0]].iter().enumerate()
+        {
+            let mut q = p;
+            q.base_position = [0.4, -0.3, 0.2];
+            q.base_rpy = *rpy;
+            let r = rotation(*rpy);
+            let local = robot.hips.map(|h| [h[0] - 0.05 * k as f64, h[1], h[2] - 0.4]);
+            q.feet = local.map(|b| apply(&r, q.base_position, b));
+            q.feet[2] = apply(&r, q.base_position, [-0.6, 0.32, -0.4]);
+            let legs = solve_chains(&robot, &q, 0.002).unwrap();
+            let from_chains = model.com_of_solved(&legs);
+            let from_angles = model.com(q.base_position, q.base_rpy, &legs.joints());
+            for i in 0..3 {
+                assert!((from_chains[i] - from_angles[i]).abs() < 1e-12, "{from_chains:?}");
+            }
+            let c = solved_com_estimate(&robot, &q, &legs);
+            assert_eq!(c, com_estimate(&robot, &q).unwrap());
+        }
+    }
+
+    #[test]
+    fn base_z_in_a_given_frame() {
+        // Pitched nose down by 0.1: the front hips (0.35 m ahead, 0.05 m below the
+        // origin) sink by 0.35·sin 0.1, so over ground 0 everywhere they set the height.
+        let robot = RobotDescription::reference();
+        let rpy = [0.0, 0.1, 0.0];
+        let z = base_z_in(&robot, &[0.0; 4], &rotation(rpy), 0.45);
+        let front = 0.35 * -(0.1f64.sin()) - 0.05 * 0.1f64.cos();
+        assert!((z - (0.45 - front)).abs() < 1e-12, "{z}");
+        assert_eq!(z, base_z(&robot, &[0.0; 4], rpy, 0.45));
+    }
+
+    #[test]
     fn a_knee_in_the_platform_is_a_collision() {
         // Rear legs on the floor with the platform edge 0.1 m ahead of the rear hips: the
         // rear knees point forward, over the platform. Standing tall they clear it; with
@@ -740,16 +836,16 @@ mod tests {
         let pose =
             |h: f64| level_posture(&robot, feet, [true; 4], [0.0, 0.0], [0.0, 0.0, 0.0], h, ground);
         let low = pose(0.27);
-        let q = solve_legs(&robot, &low, 0.0).unwrap();
+        let legs = solve_chains(&robot, &low, 0.0).unwrap();
         let hm = hm.dilated_max(crate::cost::LEG_TERRAIN_CELLS);
-        match r.legs_clear(&robot, &hm, &low, &q) {
+        match r.legs_clear(&robot, &hm, &legs) {
             Err(PostureError::LegCollision { leg, clearance }) => {
                 assert!(!leg.is_front() && clearance < 0.04, "{leg:?} {clearance}");
             }
             other => panic!("expected a collision, got {other:?}"),
         }
         let tall = pose(0.45);
-        let q = solve_legs(&robot, &tall, 0.0).unwrap();
-        assert!(r.legs_clear(&robot, &hm, &tall, &q).is_ok());
+        let legs = solve_chains(&robot, &tall, 0.0).unwrap();
+        assert!(r.legs_clear(&robot, &hm, &legs).is_ok());
     }
 }

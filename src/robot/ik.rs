@@ -57,9 +57,26 @@ pub fn world_down(pitch: f64) -> [f64; 2] {
 /// `contact`, in the base frame of a base pitched by `pitch`, the wheel level: the foot
 /// segment and wheel radius straight up from the contact along [`world_down`].
 pub fn ankle_of_contact(robot: &RobotDescription, contact: [f64; 2], pitch: f64) -> [f64; 2] {
-    let down = world_down(pitch);
+    ankle_above(robot, contact, world_down(pitch))
+}
+
+/// [`ankle_of_contact`] with world down in the base frame (`down`, [`world_down`]) given.
+fn ankle_above(robot: &RobotDescription, contact: [f64; 2], down: [f64; 2]) -> [f64; 2] {
     let below = robot.foot_length + robot.wheel_radius;
     [contact[0] - below * down[0], contact[1] - below * down[1]]
+}
+
+/// One leg solved by the sagittal IK ([`leg_chain`]): the joint angles and the points of
+/// its chain, which the posture checks (thigh and shin clearance, the lumped CoM) need and
+/// would otherwise recompute from the angles with six sines and cosines.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegChain {
+    /// Joint angles (hip, knee, ankle), rad.
+    pub joints: [f64; 3],
+    /// The knee (x', z') relative to the hip in the base frame, m.
+    pub knee: [f64; 2],
+    /// The ankle (x', z') relative to the hip in the base frame, m.
+    pub ankle: [f64; 2],
 }
 
 /// Joint angles (hip, knee, ankle) that put the wheel's ground contact point at `contact`
@@ -74,11 +91,32 @@ pub fn leg_ik(
     contact: [f64; 2],
     pitch: f64,
 ) -> Result<[f64; 3], IkError> {
+    leg_chain(robot, leg, contact, pitch, world_down(pitch)).map(|c| c.joints)
+}
+
+/// [`leg_ik`] with the knee and the ankle it solves for: `down` is [`world_down`]`(pitch)`,
+/// which a posture computes once for its four legs. The knee comes without trigonometry:
+/// it lies `l1` from the hip and `l2` from the ankle, on the side of the hip–ankle line
+/// its leg's knees point to, so it is the hip–ankle direction turned by γ with
+/// cos γ = (l1² + d² − l2²)/(2·l1·d), d the hip–ankle distance; the hip angle is that
+/// direction's angle β less γ. The knee equals [`knee_and_ankle`] of the joint angles to
+/// rounding (about 1e-16 m), as the angles do the textbook solution's (q1 = β −
+/// atan2(l2·sin q2, l1 + l2·cos q2)).
+///
+/// # Errors
+/// [`IkError`] as [`leg_ik`].
+pub fn leg_chain(
+    robot: &RobotDescription,
+    leg: Leg,
+    contact: [f64; 2],
+    pitch: f64,
+    down: [f64; 2],
+) -> Result<LegChain, IkError> {
     if !(contact[0].is_finite() && contact[1].is_finite() && pitch.is_finite()) {
         return Err(IkError::NotFinite { leg });
     }
     let (l1, l2) = (robot.thigh_length, robot.shin_length);
-    let ankle = ankle_of_contact(robot, contact, pitch);
+    let ankle = ankle_above(robot, contact, down);
     let d2 = ankle[0] * ankle[0] + ankle[1] * ankle[1];
     let d = d2.sqrt();
     if d > l1 + l2 || d < (l1 - l2).abs() {
@@ -87,8 +125,18 @@ pub fn leg_ik(
     let c2 = ((d2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)).clamp(-1.0, 1.0);
     let knee_sign = if leg.is_front() { -1.0 } else { 1.0 };
     let q2 = knee_sign * c2.acos();
+    // The thigh leaves the hip–ankle line by γ towards the side the knee points to:
+    // cos γ = (l1² + d² − l2²)/(2·l1·d) by the law of cosines.
+    let (cos_g, sin_g) = if d > 0.0 {
+        let cos_g = ((l1 * l1 + d2 - l2 * l2) / (2.0 * l1 * d)).clamp(-1.0, 1.0);
+        (cos_g, knee_sign * (1.0 - cos_g * cos_g).sqrt())
+    } else {
+        // The ankle on the hip (equal segments folded flat): every knee on the circle of
+        // radius l1 solves it; the thigh along β.
+        (1.0, 0.0)
+    };
     let beta = (-ankle[0]).atan2(-ankle[1]);
-    let q1 = beta - (l2 * q2.sin()).atan2(l1 + l2 * q2.cos());
+    let q1 = beta - sin_g.atan2(cos_g);
     let q3 = -pitch - q1 - q2;
     let q = [q1, q2, q3];
     for (k, name) in ["hip", "knee", "ankle"].iter().enumerate() {
@@ -103,7 +151,16 @@ pub fn leg_ik(
             });
         }
     }
-    Ok(q)
+    let knee = if d > 0.0 {
+        // The unit vector hip → ankle turned by γ.
+        let e = [ankle[0] / d, ankle[1] / d];
+        [l1 * (cos_g * e[0] - sin_g * e[1]), l1 * (sin_g * e[0] + cos_g * e[1])]
+    } else {
+        // No direction to turn: the thigh at the hip angle.
+        let a = u(q1);
+        [l1 * a[0], l1 * a[1]]
+    };
+    Ok(LegChain { joints: q, knee, ankle })
 }
 
 /// The knee and the ankle (x', z') relative to the hip, in the base frame, for joint
@@ -162,6 +219,72 @@ mod tests {
                 assert!((p[0] - x).abs() < 1e-9 && (p[1] - z).abs() < 1e-9, "{leg:?} {p:?}");
             }
         }
+    }
+
+    #[test]
+    fn leg_chain_knee_by_hand() {
+        // Contact 0.27 m below the hip, level base: the ankle 0.09 m below the hip, the
+        // knee halfway down (z' = −0.045) and √(0.25² − 0.045²) to the side its knees
+        // point to, backward for a front leg, forward for a rear one.
+        let rb = robot();
+        let side = (0.25f64 * 0.25 - 0.045 * 0.045).sqrt();
+        for (leg, x) in [(Leg::FrontLeft, -side), (Leg::RearRight, side)] {
+            let c = leg_chain(&rb, leg, [0.0, -0.27], 0.0, world_down(0.0)).unwrap();
+            assert!((c.knee[0] - x).abs() < 1e-12 && (c.knee[1] + 0.045).abs() < 1e-12, "{c:?}");
+            assert!(c.ankle[0].abs() < 1e-12 && (c.ankle[1] + 0.09).abs() < 1e-12, "{c:?}");
+            assert_eq!(c.joints, leg_ik(&rb, leg, [0.0, -0.27], 0.0).unwrap());
+        }
+    }
+
+    #[test]
+    fn leg_chain_equals_forward_kinematics_of_its_angles() {
+        // Over a grid of contacts and pitches, every reachable one: the chain's knee and
+        // ankle are those the joint angles give, to rounding.
+        let rb = robot();
+        let mut solved = 0;
+        for leg in Leg::ALL {
+            for i in 0..=30 {
+                for j in 0..=30 {
+                    for pitch in [-0.4, -0.2, -0.05, 0.0, 0.1, 0.3] {
+                        let contact = [-0.6 + 0.04 * f64::from(i), -0.8 + 0.02 * f64::from(j)];
+                        let Ok(c) = leg_chain(&rb, leg, contact, pitch, world_down(pitch)) else {
+                            continue;
+                        };
+                        assert_eq!(c.joints, leg_ik(&rb, leg, contact, pitch).unwrap());
+                        // The textbook hip angle, from the knee angle's sine and cosine.
+                        let [_, q2, _] = c.joints;
+                        let ankle = ankle_of_contact(&rb, contact, pitch);
+                        let (l1, l2) = (rb.thigh_length, rb.shin_length);
+                        let q1 = (-ankle[0]).atan2(-ankle[1])
+                            - (l2 * q2.sin()).atan2(l1 + l2 * q2.cos());
+                        let q3 = -pitch - q1 - q2;
+                        for (k, q) in [q1, q2, q3].into_iter().enumerate() {
+                            assert!((c.joints[k] - q).abs() < 1e-12, "{leg:?} {c:?} {q1}");
+                        }
+                        let [knee, ankle] = knee_and_ankle(&rb, c.joints);
+                        for k in 0..2 {
+                            assert!((c.knee[k] - knee[k]).abs() < 1e-12, "{leg:?} {c:?} {knee:?}");
+                            assert!((c.ankle[k] - ankle[k]).abs() < 1e-12, "{c:?} {ankle:?}");
+                        }
+                        solved += 1;
+                    }
+                }
+            }
+        }
+        assert!(solved > 4 * 1000, "{solved}");
+    }
+
+    #[test]
+    fn leg_chain_with_the_ankle_on_the_hip() {
+        // Joint limits wide enough to fold the equal segments flat: the ankle on the hip
+        // has no direction to turn, the knee comes from the angles.
+        let mut rb = robot();
+        rb.joint_ranges = [crate::robot::Range { min: -3.5, max: 3.5 }; 3];
+        let below = rb.foot_length + rb.wheel_radius;
+        let c = leg_chain(&rb, Leg::RearLeft, [0.0, -below], 0.0, world_down(0.0)).unwrap();
+        assert_eq!(c.ankle, [0.0, 0.0]);
+        assert_eq!(c.knee, knee_and_ankle(&rb, c.joints)[0]);
+        assert!((c.knee[0].hypot(c.knee[1]) - 0.25).abs() < 1e-12, "{c:?}");
     }
 
     #[test]
