@@ -83,17 +83,10 @@ fn ramp_detour_drives_up_the_ramp_with_the_pitch_following_the_slope() {
 /// measured: the course is driven with at least 2 cm of margin and no static violation.
 #[test]
 fn a_start_off_the_lattice_keeps_its_wheels_on_the_ground() {
-    use momaro::jobs::generate::checked_case;
-    use momaro::scenario::generate::Class;
-    use momaro::sim::Simulation;
-    let model = common::model();
-    let robot = Simulation::robot_only(&model).expect("model").robot().clone();
-    let dir = common::temp_dir("generated_clutter_start");
-    let (case, _) = checked_case(Class::Clutter, 52, &dir, &robot).expect("generated");
-    let sc = case.scenario(&dir).expect("scenario");
+    let sc = common::generated(momaro::scenario::generate::Class::Clutter, 52);
     let plan =
         PlanOptions { time_limit_s: 600.0, final_epsilon: Some(3.0), ..PlanOptions::default() };
-    let s = run(&sc, &RunOptions::new(plan, model)).expect("run completes");
+    let s = run(&sc, &RunOptions::new(plan, common::model())).expect("run completes");
     assert!(s.passed, "{s:#?}");
     assert!(s.min_stability_margin_m >= 0.02, "{s:#?}");
     assert_eq!(s.static_violation_s, 0.0, "{:?}", s.events);

@@ -320,14 +320,8 @@ fn an_aborted_step_returns_to_the_driving_posture_and_replans() {
 /// the terrain, and the mission passes.
 #[test]
 fn a_generated_step_down_keeps_its_knees_off_the_edge() {
-    use momaro::jobs::generate::checked_case;
-    use momaro::scenario::generate::Class;
-    let model = common::model();
-    let robot = Simulation::robot_only(&model).expect("model").robot().clone();
-    let dir = common::temp_dir("generated_step_down");
-    let (case, _) = checked_case(Class::StepDown, 98, &dir, &robot).expect("generated");
-    let sc = case.scenario(&dir).expect("scenario");
-    let s = run::run(&sc, &RunOptions::new(plan_options(), model)).expect("run");
+    let sc = common::generated(momaro::scenario::generate::Class::StepDown, 98);
+    let s = run::run(&sc, &RunOptions::new(plan_options(), common::model())).expect("run");
     assert!(s.steps_planned > 0);
     assert_clean(&s);
     assert!(s.passed, "{s:#?}");

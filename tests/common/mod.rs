@@ -26,3 +26,13 @@ pub fn temp_dir(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).expect("temp dir");
     dir
 }
+
+/// Case `seed` of `class` as `momaro generate --class C --seed S --count 1` writes it, in
+/// a fresh temporary directory named after both, loaded.
+pub fn generated(class: momaro::scenario::generate::Class, seed: u64) -> Scenario {
+    let robot = momaro::sim::Simulation::robot_only(&model()).expect("model").robot().clone();
+    let dir = temp_dir(&format!("generated_{class:?}_{seed}"));
+    let (case, _) =
+        momaro::jobs::generate::checked_case(class, seed, &dir, &robot).expect("generated");
+    case.scenario(&dir).expect("scenario")
+}
