@@ -71,7 +71,7 @@
 //! So the search's edge for a step (`SearchGraph::successors`) goes to an *intermediate
 //! node*: the same pose with [`LatticeState::step_pending`] naming the leg, at the cost of
 //! the cheapest foothold the scan found, a lower bound of the step's. Expanding the node
-//! runs the checks (`best_step`, unchanged) and gives the step itself at the rest of its
+//! runs the checks (`best_step`) and gives the step itself at the rest of its
 //! cost, or nothing. The graph is the same (paths and costs are those of checking every
 //! step at once), and the search's paths leave the nodes out
 //! (`SearchGraph::is_intermediate`). The node's heuristic is `min_c (c_c + h(t_c)) − c_lb`
@@ -878,31 +878,45 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// The cheapest abstract step of `leg` from state `s` (offsets `o`, feet `feet`),
-    /// given that criteria 1 (close to an obstacle) and 4 (support side) hold: scans the
-    /// foot's sagittal line forward to the end of the leg's reach for footholds that
-    ///
-    /// - have finite foot cost C_F (criterion 2) and lie beyond at least one cell of
-    ///   infinite C_F (the foot is carried over the obstacle, see the module docs),
-    /// - differ in height from the foot by at most `max_step_height_m` (criterion 3),
-    ///   as does every cell passed on the way,
-    /// - give a valid after-step state,
-    ///
-    /// and returns the one with the smallest C_S (eq. 5; ties: the shorter step) with its
-    /// new offsets.
+    /// given that criteria 1 (close to an obstacle) and 4 (support side) hold: of the
+    /// footholds of the scan ([`Self::step_candidates`], criteria 2 and 3, cheapest
+    /// first), the first whose after-step state may be entered and whose step passes
+    /// [`Self::step_feasible`], with its new offsets.
     fn best_step(
         &mut self,
         s: LatticeState,
         o: &FootOffsets,
         feet: &Feet,
         leg: usize,
+        candidates: Vec<StepCandidate>,
     ) -> Option<(FootOffsets, StepCost)> {
-        let candidates = self.step_candidates(s, o, feet, leg);
-        self.first_feasible_step(s, o, feet, leg, candidates)
+        candidates.into_iter().find_map(|(_, d, cost, foothold)| {
+            let mut o2 = *o;
+            o2[leg] = (i32::from(o[leg]) + d) as i8;
+            let key = ((s.i, s.j, s.theta, *o), leg as u8, o2[leg]);
+            let known = self.step_checks.get(&key).copied();
+            if !self.target_ok(s, &o2) {
+                return None;
+            }
+            let ok = known.unwrap_or_else(|| {
+                let ok = self.step_feasible(s, feet, leg, foothold);
+                self.step_checks.insert(key, ok);
+                ok
+            });
+            ok.then_some((o2, cost))
+        })
     }
 
-    /// The footholds of `best_step` by the scan alone (C_S, offset change, cost terms,
-    /// foothold x, y, z), cheapest first (ties: the shorter step): the checks that need
-    /// the IK are left to [`Self::first_feasible_step`].
+    /// The footholds of `leg`'s step by the scan alone (C_S, offset change, cost terms,
+    /// foothold x, y, z), cheapest first (ties: the shorter step): the foot's sagittal
+    /// line forward to the end of the leg's reach, footholds that
+    ///
+    /// - have finite foot cost C_F (criterion 2) and lie beyond at least one cell of
+    ///   infinite C_F (the foot is carried over the obstacle, see the module docs),
+    /// - differ in height from the foot by at most `max_step_height_m` (criterion 3),
+    ///   as does every cell passed on the way.
+    ///
+    /// The checks that need the IK are left to [`Self::best_step`].
     fn step_candidates(
         &self,
         s: LatticeState,
@@ -954,33 +968,6 @@ impl<'c> HybridGraph<'c> {
         candidates
     }
 
-    /// The first of `candidates` (from [`Self::step_candidates`]) whose after-step state
-    /// may be entered and whose step passes [`Self::step_feasible`], with its offsets.
-    fn first_feasible_step(
-        &mut self,
-        s: LatticeState,
-        o: &FootOffsets,
-        feet: &Feet,
-        leg: usize,
-        candidates: Vec<StepCandidate>,
-    ) -> Option<(FootOffsets, StepCost)> {
-        candidates.into_iter().find_map(|(_, d, cost, foothold)| {
-            let mut o2 = *o;
-            o2[leg] = (i32::from(o[leg]) + d) as i8;
-            let key = ((s.i, s.j, s.theta, *o), leg as u8, o2[leg]);
-            let known = self.step_checks.get(&key).copied();
-            if !self.target_ok(s, &o2) {
-                return None;
-            }
-            let ok = known.unwrap_or_else(|| {
-                let ok = self.step_feasible(s, feet, leg, foothold);
-                self.step_checks.insert(key, ok);
-                ok
-            });
-            ok.then_some((o2, cost))
-        })
-    }
-
     /// Mean foot cost along a wheel pair's straight drive of `cells` cells from `p` in
     /// direction `dir` (both ends included); `None` if any cell is not drivable.
     fn drive_line_cost(
@@ -1021,7 +1008,6 @@ impl<'c> HybridGraph<'c> {
         let Some(feet) = self.feet_of(s, &o) else {
             return;
         };
-        let f = self.config.step_cost_factor;
         let res = self.lattice.resolution;
         let heading = self.heading(s.theta);
 
@@ -1035,27 +1021,16 @@ impl<'c> HybridGraph<'c> {
             if self.side_length(&o, !leg.is_left()) <= self.config.min_support_side_length_m {
                 continue;
             }
+            let candidates = self.step_candidates(s, &o, &feet, k);
             if lazy {
                 // The cheapest foothold by the scan: a lower bound of the step's cost.
-                let Some(&(c_s, _, step, _)) = self.step_candidates(s, &o, &feet, k).first() else {
-                    continue;
-                };
-                let pending = LatticeState { step_pending: leg_tag(k), ..s };
-                let cost = f * c_s;
-                self.special.push((
-                    pending,
-                    edge_cost(cost),
-                    Manoeuvre {
-                        kind: ManoeuvreKind::Step,
-                        leg: Some(leg),
-                        length_m: step.length_m,
-                        cost,
-                        step: Some(step),
-                    },
-                ));
+                if let Some(&(_, _, step, _)) = candidates.first() {
+                    let (cost, m) = self.step_edge(k, step);
+                    self.special.push((LatticeState { step_pending: leg_tag(k), ..s }, cost, m));
+                }
                 continue;
             }
-            if let Some(edge) = self.checked_step(s, &o, &feet, k) {
+            if let Some(edge) = self.checked_step(s, &o, &feet, k, candidates) {
                 self.special.push(edge);
             }
         }
@@ -1110,19 +1085,10 @@ impl<'c> HybridGraph<'c> {
         }
     }
 
-    /// The step of leg `k` from state `s` (offsets `o`, feet `feet`) to the cheapest
-    /// foothold that passes every check (`best_step`), labelled, at its full cost.
-    fn checked_step(
-        &mut self,
-        s: LatticeState,
-        o: &FootOffsets,
-        feet: &Feet,
-        k: usize,
-    ) -> Option<(LatticeState, Cost, Manoeuvre)> {
-        let (o2, step) = self.best_step(s, o, feet, k)?;
-        let t = self.with_footprint(s, o2)?;
+    /// A step of leg `k` with cost terms `step`: its edge cost (C_S times the
+    /// step-related factor) and label.
+    fn step_edge(&self, k: usize, step: StepCost) -> (Cost, Manoeuvre) {
         let cost = self.config.step_cost_factor * step.c_s;
-        self.stats.steps += 1;
         let m = Manoeuvre {
             kind: ManoeuvreKind::Step,
             leg: Some(Leg::ALL[k]),
@@ -1130,7 +1096,25 @@ impl<'c> HybridGraph<'c> {
             cost,
             step: Some(step),
         };
-        Some((t, edge_cost(cost), m))
+        (edge_cost(cost), m)
+    }
+
+    /// The step of leg `k` from state `s` (offsets `o`, feet `feet`) to the cheapest of
+    /// the scan's `candidates` that passes every check (`best_step`), labelled, at its
+    /// full cost.
+    fn checked_step(
+        &mut self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        k: usize,
+        candidates: Vec<StepCandidate>,
+    ) -> Option<(LatticeState, Cost, Manoeuvre)> {
+        let (o2, step) = self.best_step(s, o, feet, k, candidates)?;
+        let t = self.with_footprint(s, o2)?;
+        self.stats.steps += 1;
+        let (cost, m) = self.step_edge(k, step);
+        Some((t, cost, m))
     }
 
     /// The successor of an intermediate node `p` (see "Lazy step checks" in the module
@@ -1141,9 +1125,10 @@ impl<'c> HybridGraph<'c> {
         let s = LatticeState { step_pending: 0, ..p };
         let o = self.footprints.get(s.footprint)?;
         let feet = self.feet_of(s, &o)?;
-        let &(c_lb, ..) = self.step_candidates(s, &o, &feet, k).first()?;
-        let charged = edge_cost(self.config.step_cost_factor * c_lb);
-        let (t, cost, m) = self.checked_step(s, &o, &feet, k)?;
+        let candidates = self.step_candidates(s, &o, &feet, k);
+        let &(_, _, cheapest, _) = candidates.first()?;
+        let (charged, _) = self.step_edge(k, cheapest);
+        let (t, cost, m) = self.checked_step(s, &o, &feet, k, candidates)?;
         Some((t, cost.saturating_sub(charged), m))
     }
 

@@ -33,7 +33,7 @@ pub struct ExecutorConfig {
     /// Integral gain of the base height hold during standing manoeuvres, 1/s. The leg
     /// joints are position servos (the model's kp): under the robot's weight the support
     /// legs give, most when one foot is lifted and three carry it, and the base sinks
-    /// 1–2 cm below its keyframes. A lifted front leg folds its knee under its hip as the
+    /// 1–2 cm below its keyframes. A lifted leg folds its knee under its hip as the
     /// foot passes below it, so a sunken base carries that knee into the step's edge the
     /// plan's leg clearance kept it from. The executor raises its commanded base by the
     /// integral of the measured shortfall, `lift += gain · (z_commanded − z_measured) · dt`,
