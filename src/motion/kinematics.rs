@@ -318,12 +318,7 @@ pub fn driving_posture(
     }
     let pitch = pitch_from_feet(&feet, pose.theta, pitch_fraction);
     let r = rotation([0.0, pitch, pose.theta]);
-    let z = (0..4)
-        .map(|i| {
-            let h = robot.hips[i];
-            feet[i][2] + leg_height - (r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2])
-        })
-        .fold(f64::NEG_INFINITY, f64::max);
+    let z = super::standing::base_z_in(robot, &feet.map(|f| f[2]), &r, leg_height);
     Ok(Posture {
         base_position: [pose.x, pose.y, z],
         base_rpy: [0.0, pitch, pose.theta],
