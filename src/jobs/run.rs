@@ -28,7 +28,7 @@ use crate::rng::Rng;
 use crate::robot::Leg;
 use crate::robot::ik::IkError;
 use crate::scenario::{Outcome, Scenario, Stepping};
-use crate::sim::{SimError, Simulation};
+use crate::sim::{BaseState, SimError, Simulation};
 use crate::terrain::HeightMap;
 use crate::viz::{Recorder, VizError};
 use serde::Serialize;
@@ -552,12 +552,13 @@ fn chain(e: &dyn std::error::Error) -> String {
     s
 }
 
-/// What the executor sees of the simulation, with `measured` as the base pose.
-fn observe(sim: &Simulation, measured: Pose2) -> Observation {
+/// What the executor sees of the simulation, with `measured` as the planar base pose and
+/// the height of `base` (the simulated base, read once per tick).
+fn observe(sim: &Simulation, base: &BaseState, measured: Pose2) -> Observation {
     Observation {
         time: sim.time(),
         base: measured,
-        base_z: Some(sim.base().position[2]),
+        base_z: Some(base.position[2]),
         joints: Leg::ALL.map(|l| sim.leg_joints(l)),
         steering: Leg::ALL.map(|l| sim.steering_angle(l)),
         steering_rate: Leg::ALL.map(|l| sim.steering_rate(l)),
@@ -658,7 +659,7 @@ pub fn execute(
             ),
             None => truth,
         };
-        let obs = observe(sim, measured);
+        let obs = observe(sim, &base, measured);
         let (cmd, status) = exec.tick(&obs, control_dt);
         match status {
             ExecStatus::Finished => {
