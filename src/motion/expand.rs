@@ -499,18 +499,17 @@ impl<'a> Expander<'a> {
         [self.cur.base_position[0], self.cur.base_position[1]]
     }
 
-    /// Builds the keyframes of one step candidate, the foot carried at `swing_z`.
-    #[allow(clippy::too_many_arguments)]
-    fn step_candidate(
+    /// The alignment of one step candidate before its base shift: the partner wheel
+    /// toward the centre (`wheel_fraction` of the way) and the roll (`roll_fraction`),
+    /// at leg height `height`. Candidates that differ only in their shift share it.
+    fn step_alignment(
         &mut self,
         leg: Leg,
         post_foot: [f64; 3],
-        swing_z: f64,
         height: f64,
         wheel_fraction: f64,
         roll_fraction: f64,
-        shift: Shift,
-    ) -> Result<Vec<Planned>, String> {
+    ) -> Result<Alignment, String> {
         let o = *self.o;
         let i = leg.index();
         let j = leg.same_side_partner().index();
@@ -519,13 +518,9 @@ impl<'a> Expander<'a> {
         let along = |f: [f64; 3]| c * f[0] + s * f[1];
         let lateral = |f: [f64; 3]| -s * f[0] + c * f[1];
         let pre = self.cur.feet;
-        let StepStance { post, pitch, ground } =
-            self.o.standing.step_stance(&pre, i, post_foot, yaw);
-        let pitch_post = self.pitch_for(&post, yaw);
+        let StepStance { pitch, ground, .. } = self.o.standing.step_stance(&pre, i, post_foot, yaw);
         let xy = self.xy();
         let all = [true; 4];
-        let mut lifted = all;
-        lifted[i] = false;
 
         // Longitudinal alignment: the partner wheel toward the centre (Fig. 12a).
         let p0 = self.standing(pre, all, xy, yaw, pitch, 0.0, height, ground);
@@ -562,10 +557,25 @@ impl<'a> Expander<'a> {
             }
             d = e;
         }
-        let mut moved = pre;
-        if d > 0.0 {
-            let (x, y) = (pre[j][0] + sign * d * c, pre[j][1] + sign * d * s);
-            moved[j] = [x, y, self.maps.height_at(x, y).unwrap_or(pre[j][2])];
+        // ... and as far as the partner's leg reaches at this stance: a wheel driven past
+        // it would fail the step, where a shorter move leaves the rest to the roll and the
+        // base shift.
+        let moved_by = |d: f64| {
+            let mut moved = pre;
+            if d > 0.0 {
+                let (x, y) = (pre[j][0] + sign * d * c, pre[j][1] + sign * d * s);
+                moved[j] = [x, y, self.maps.height_at(x, y).unwrap_or(pre[j][2])];
+            }
+            moved
+        };
+        let mut moved = moved_by(d);
+        while d > 0.0 {
+            let p = self.standing(moved, all, xy, yaw, pitch, 0.0, height, ground);
+            if solve_chains(self.robot, &p, self.o.standing.reach_margin_m).is_ok() {
+                break;
+            }
+            d = (d - step).max(0.0);
+            moved = moved_by(d);
         }
 
         // Lateral alignment: roll (eqs. 6–8), iterated with the CoM model.
@@ -606,6 +616,35 @@ impl<'a> Expander<'a> {
             let Some((r, c)) = next else { break };
             (roll, com) = (r, c);
         }
+
+        Ok(Alignment { height, d, wanted, moved, roll, com, stc })
+    }
+
+    /// Builds the keyframes of one step candidate from its alignment, the foot carried
+    /// at `swing_z`.
+    fn step_candidate(
+        &self,
+        leg: Leg,
+        post_foot: [f64; 3],
+        swing_z: f64,
+        aligned: &Alignment,
+        shift: Shift,
+    ) -> Vec<Planned> {
+        let o = *self.o;
+        let i = leg.index();
+        let j = leg.same_side_partner().index();
+        let yaw = self.cur.base_rpy[2];
+        let (s, c) = yaw.sin_cos();
+        let along = |f: [f64; 3]| c * f[0] + s * f[1];
+        let pre = self.cur.feet;
+        let StepStance { post, pitch, ground } =
+            self.o.standing.step_stance(&pre, i, post_foot, yaw);
+        let pitch_post = self.pitch_for(&post, yaw);
+        let xy = self.xy();
+        let all = [true; 4];
+        let mut lifted = all;
+        lifted[i] = false;
+        let Alignment { height, d, wanted, moved, roll, com, stc } = *aligned;
 
         // Longitudinal remainder: base shift (Fig. 12b).
         // Only when the wheel could not go as far as alignment wanted (blocked, or a
@@ -660,7 +699,7 @@ impl<'a> Expander<'a> {
             None,
             self.standing(back, all, xy, yaw, pitch_post, 0.0, height, post_ground),
         ));
-        Ok(seq)
+        seq
     }
 
     /// Expands a step of `leg` to `post_foot` from the current posture with the
@@ -698,9 +737,9 @@ impl<'a> Expander<'a> {
         let pre = self.cur.feet;
         let rule = self.o.standing;
         // The same for every candidate (what `step_heights` checked the swing at).
-        let swing_z = rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot);
+        let swing_z =
+            rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot, self.cur.base_rpy[2]);
         let mut best: (f64, String) = (f64::NEG_INFINITY, "no candidate".to_owned());
-        let mut previous: Option<Vec<Planned>> = None;
         let candidates: Box<dyn Iterator<Item = (f64, f64, f64, Shift)>> = match search {
             StepSearch::Planner => {
                 Box::new(heights.take(PLANNER_STEP_HEIGHTS).flat_map(|h| {
@@ -709,9 +748,23 @@ impl<'a> Expander<'a> {
             }
             StepSearch::Full => Box::new(full_candidates(&heights.collect::<Vec<_>>()).into_iter()),
         };
+        // Candidates that differ only in their shift share their alignment, and those
+        // whose sequences come out the same (no shift where the wheel was not hindered)
+        // are checked once.
+        let mut alignments: Vec<(AlignmentKey, Result<Alignment, String>)> = Vec::new();
+        let mut tried: Vec<Vec<Planned>> = Vec::new();
         for (h, wf, rf, shift) in candidates {
-            let seq = match self.step_candidate(leg, post_foot, swing_z, h, wf, rf, shift) {
-                Ok(s) => s,
+            let key = (h, wf, rf);
+            let aligned = match alignments.iter().find(|(k, _)| *k == key) {
+                Some((_, a)) => a.clone(),
+                None => {
+                    let a = self.step_alignment(leg, post_foot, h, wf, rf);
+                    alignments.push((key, a.clone()));
+                    a
+                }
+            };
+            let aligned = match aligned {
+                Ok(a) => a,
                 Err(e) => {
                     if best.0 == f64::NEG_INFINITY {
                         best.1 = e;
@@ -719,9 +772,8 @@ impl<'a> Expander<'a> {
                     continue;
                 }
             };
-            // Alignments that came out the same (no shift where the wheel was not
-            // hindered) are checked once.
-            if previous.as_ref() == Some(&seq) {
+            let seq = self.step_candidate(leg, post_foot, swing_z, &aligned, shift);
+            if tried.contains(&seq) {
                 continue;
             }
             match self.trial(&seq) {
@@ -739,7 +791,7 @@ impl<'a> Expander<'a> {
                     }
                 }
             }
-            previous = Some(seq);
+            tried.push(seq);
         }
         Err(MotionError::Step {
             index: self.index,
@@ -866,6 +918,28 @@ pub fn step_motion(
         StepSearch::Planner,
         heights,
     )
+}
+
+/// What a step candidate's alignment depends on: leg height, wheel and roll fractions.
+type AlignmentKey = (f64, f64, f64);
+
+/// A step candidate's alignment before its base shift ([`Expander::step_alignment`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Alignment {
+    /// Leg height of the standing rule, m.
+    height: f64,
+    /// How far the partner wheel moves toward the centre, m.
+    d: f64,
+    /// How far longitudinal alignment wanted it to move, m.
+    wanted: f64,
+    /// The feet with the partner moved.
+    moved: [[f64; 3]; 4],
+    /// Base roll, rad.
+    roll: f64,
+    /// CoM after the roll.
+    com: [f64; 3],
+    /// Centroid of the support triangle (x, y).
+    stc: [f64; 3],
 }
 
 /// The longitudinal base shift of a step candidate.

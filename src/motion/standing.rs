@@ -66,17 +66,33 @@ impl StandingRule {
         }
     }
 
-    /// Swing height of a foot carried from `a` to `b`: `swing_clearance_m` above the
-    /// highest terrain within a wheel pair's half-width (plus 2 cm) of its straight path.
+    /// Swing height of a foot carried from `a` to `b` under heading `yaw`:
+    /// `swing_clearance_m` above the highest terrain within a wheel radius (plus
+    /// [`SWING_SCAN_PAD_M`]) of either wheel's straight path. The wheels are the model's
+    /// spheres at ±track/2 along the axle, which is across the foot's heading (the base
+    /// heading), so the swept volume reaches a wheel radius ahead and behind but
+    /// track/2 + a wheel radius to the sides: a foot set down close before a stair's next
+    /// riser does not have to be carried over that riser.
     pub fn swing_z(
         &self,
         robot: &RobotDescription,
         heights: &HeightMap,
         a: [f64; 3],
         b: [f64; 3],
+        yaw: f64,
     ) -> f64 {
-        let radius = robot.wheel_pair_radius() + 0.02;
-        heights.max_height_near_segment(a, b, radius) + self.swing_clearance_m
+        let radius = robot.wheel_radius + SWING_SCAN_PAD_M;
+        let (s, c) = yaw.sin_cos();
+        let half = robot.wheel_track / 2.0;
+        let top = [-1.0, 1.0]
+            .map(|side| {
+                let (ox, oy) = (-s * half * side, c * half * side);
+                let end = |p: [f64; 3]| [p[0] + ox, p[1] + oy, p[2]];
+                heights.max_height_near_segment(end(a), end(b), radius)
+            })
+            .into_iter()
+            .fold(f64::NEG_INFINITY, f64::max);
+        top + self.swing_clearance_m
     }
 
     /// The heights tried, soft constraint first.
@@ -233,7 +249,7 @@ impl StandingRule {
             .heights()
             .any(|h| (lo..=hi).contains(&h) && probes.iter().all(|p| p.distances_ok(h).is_ok()));
         if grounded {
-            let swing_z = self.swing_z(robot, heights, pre[leg], post_foot);
+            let swing_z = self.swing_z(robot, heights, pre[leg], post_foot, yaw);
             // The swing at most 5 cm apart, ends included, and where the foot passes
             // closest under its hip (1 cm either side, the generator's spacing): the
             // hip-to-ankle distance is convex along the straight swing, so the knee
@@ -317,6 +333,10 @@ pub struct StepStance {
     /// Ground height under each leg, the stepping leg's the higher of its two, m.
     pub ground: [f64; 4],
 }
+
+/// What the swing scan adds to the wheel radius around each wheel's path, m: the
+/// tracking error a swinging foot is allowed.
+pub const SWING_SCAN_PAD_M: f64 = 0.02;
 
 /// Spacing of the swing points [`StandingRule::step_heights`] checks, m.
 const SWING_SAMPLE_M: f64 = 0.05;
@@ -605,6 +625,7 @@ fn level_posture_in(
 mod tests {
     use super::*;
     use crate::motion::kinematics::solve_legs;
+    use std::f64::consts::FRAC_PI_2;
 
     fn rule() -> StandingRule {
         StandingRule::from_params(&Params::default())
@@ -616,6 +637,40 @@ mod tests {
             if -2.0 + (i as f64 + 0.5) * 0.025 >= 0.2 { 0.2 } else { 0.0 }
         })
         .unwrap()
+    }
+
+    #[test]
+    fn a_swing_clears_what_the_wheels_pass_not_a_disc_around_the_foot() {
+        // A tread at 0.17 m from x = 0 to 0.29, the next at 0.34 m beyond; a 0.40 m post
+        // at y from 0.125 to 0.15, x from −0.6 to −0.5. A foot carried along +x from (−0.16, 0) to
+        // (0.1625, 0) onto the tread: its wheels (spheres of 0.08 m at y = ±0.06) swept
+        // with 2 cm to spare reach x = 0.2625, short of the next riser (0.29), so the
+        // swing is 0.17 + 0.05. The disc of the pair's radius (0.16 m) reached 0.3225 and
+        // carried the foot over the next step (0.39), out of reach for the leg.
+        let robot = RobotDescription::reference();
+        let map = HeightMap::from_fn([-1.0, -1.0], 0.025, 80, 80, |i, j| {
+            let (x, y) = (-1.0 + (i as f64 + 0.5) * 0.025, -1.0 + (j as f64 + 0.5) * 0.025);
+            if (0.125..0.15).contains(&y) && (-0.6..-0.5).contains(&x) {
+                0.4
+            } else if x >= 0.29 {
+                0.34
+            } else if x >= 0.0 {
+                0.17
+            } else {
+                0.0
+            }
+        })
+        .unwrap();
+        let rule = rule();
+        let (a, b) = ([-0.16, 0.0, 0.0], [0.1625, 0.0, 0.17]);
+        assert!((rule.swing_z(&robot, &map, a, b, 0.0) - 0.22).abs() < 1e-9);
+        // Heading along y, the same path passes the wheels sideways: the riser, 0.1275 m
+        // from the foothold, is under a wheel's 0.10 m reach (0.06 + 0.10 across).
+        assert!((rule.swing_z(&robot, &map, a, b, FRAC_PI_2) - 0.39).abs() < 1e-9);
+        // Past the post: its cells' centres (y = 0.1375) lie 0.0775 m from the
+        // left wheel's path (y = 0.06), inside 0.10: carried over it.
+        let (a, b) = ([-0.8, 0.0, 0.0], [-0.3, 0.0, 0.0]);
+        assert!((rule.swing_z(&robot, &map, a, b, 0.0) - 0.45).abs() < 1e-9);
     }
 
     #[test]
