@@ -41,7 +41,8 @@
 //!   also needs a CoM estimate (`motion::standing::com_estimate`: base body and legs
 //!   lumped, the robot standing by the rule) inside the support triangle of the other
 //!   three feet, with the partner wheel driven toward the centre as far as the generator
-//!   may (`Params::step_support_margin_m`): roll and a base shift align the rest. That is
+//!   may (`HybridGraph::step_supported`; with `step_model = "stairs"` the generator's
+//!   lift keyframe through its roll and base-shift alignments). That is
 //!   the cheap filter; a step that passes it must then pass the generator's own check
 //!   (`motion::expand::step_motion`: roll, wheel to centre, base shift, lift, swing,
 //!   place and back, every centimetre, with the CoM estimate and 3 mm of margin to
@@ -60,6 +61,14 @@
 //!   up for manoeuvres, Sec. VI-B), and the two feet of each side at least half the
 //!   support length (`min_support_side_length_m` / 2) apart, so wheel pairs never
 //!   collide. Only neutral states drive.
+//! - *The rear-step approach* (`step_model = "stairs"` only): where the front feet stand
+//!   on other ground than the rear ones, a rear foot is not close to an obstacle and a
+//!   front foot's way ahead is blocked, a base shift past the front feet's neutral (their
+//!   legs reach back) to the first length at which a rear foot, rolled forward to
+//!   neutral, comes close to one. Without it the feet of one side stay a hip spacing
+//!   (0.7 m) apart, and on treads shorter than that no footprint puts a rear foot at a
+//!   riser while the front feet stand on a tread. It is a base shift like the others
+//!   (same cost, same heuristic terms), so the heuristic stays consistent.
 //! - *Base shifts* end on the lattice cell containing the exact shifted position (the
 //!   feet then stand up to half a cell from where they were; the paper's grid has the
 //!   same issue). The edge cost is `max(C_BS · factor, distance moved)`, which keeps the
@@ -117,11 +126,13 @@ use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Nei
 use super::reachability::BaseRegions;
 use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
-use crate::geometry::Pose2;
+use crate::geometry::{Pose2, norm2};
+use crate::motion::CenterOfMassModel;
 use crate::motion::expand::{self, MotionOptions};
-use crate::motion::kinematics::hips_in_world;
-use crate::motion::standing::{EstimatedCom, com_estimate};
-use crate::params::Params;
+use crate::motion::kinematics::{hips_in_world, solve_chains};
+use crate::motion::roll::roll_for_lateral_com;
+use crate::motion::standing::{EstimatedCom, StepStance, com_estimate, level_posture};
+use crate::params::{Params, StepModel};
 use crate::planner::{Cost, FxBuild, SearchGraph};
 use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
@@ -225,10 +236,10 @@ pub struct HybridConfig {
     pub step_obstacle_distance_m: f64,
     /// Criterion 3: largest |ΔH| of a step, m.
     pub max_step_height_m: f64,
+    /// Largest height difference a wheel drives over (eq. 2), m.
+    pub max_foot_height_diff_m: f64,
     /// Criterion 4: the feet on the non-stepping side must be farther apart, m.
     pub min_support_side_length_m: f64,
-    /// Smallest signed distance of the base centre to a step's support triangle, m.
-    pub step_support_margin_m: f64,
     /// Shortest "front foot forward" move, m (each such move drives as far as it can).
     pub foot_move_increment_m: f64,
     /// Cap on distinct footprints (graph size guard).
@@ -238,6 +249,11 @@ pub struct HybridConfig {
     pub max_oriented_nodes: usize,
     /// Smallest stability margin of a posture, m (the generator's requirement).
     pub min_stability_margin_m: f64,
+    /// How steps are prepared and pre-checked ([`StepModel`]).
+    pub step_model: StepModel,
+    /// [`StepModel::Paper`]'s pre-check: the least margin of the CoM estimate in a
+    /// step's support triangle at the unaligned stance, m.
+    pub step_support_margin_m: f64,
     /// The motion generator's constants: the leg-height rule for standing manoeuvres
     /// (reach and leg clearance, Sec. VI-B), the driving leg height, the base circles'
     /// radius, the wheel-to-centre move and gap of a step; with them steps are checked
@@ -257,6 +273,10 @@ fn leg_tag(k: usize) -> u8 {
 /// so the generator's roll may differ slightly from the planner's.
 pub const PLANNER_MARGIN_SLACK_M: f64 = 0.003;
 
+/// The fractions of the way to the support centroid the generator's planner candidates
+/// roll and shift (`expand::PLANNER_ALIGNMENTS`).
+const ALIGNMENT_FRACTIONS: [f64; 3] = [0.0, 0.5, 1.0];
+
 impl HybridConfig {
     /// From the paper's constants and the robot's neutral footprint; the shortest foot
     /// move is 0.1 m and up to 65 536 footprints (all `u16` ids) are allowed.
@@ -271,12 +291,14 @@ impl HybridConfig {
             step_cost_factor: params.step_cost_factor,
             step_obstacle_distance_m: params.step_obstacle_distance_m,
             max_step_height_m: params.max_step_height_m,
+            max_foot_height_diff_m: params.max_foot_height_diff_m,
             min_support_side_length_m: params.min_support_side_length_m,
-            step_support_margin_m: params.step_support_margin_m,
             foot_move_increment_m: 0.1,
             max_footprints: 65_536,
             max_oriented_nodes: super::cost_to_go::MAX_ORIENTED_NODES,
             min_stability_margin_m: params.min_stability_margin_m,
+            step_model: params.step_model,
+            step_support_margin_m: params.step_support_margin_m,
             motion: {
                 let mut m = MotionOptions::from_params(params);
                 m.min_margin_m += PLANNER_MARGIN_SLACK_M;
@@ -1050,6 +1072,33 @@ impl<'c> HybridGraph<'c> {
             }
         }
 
+        // Rear-step approach: the front feet stand on other ground than the rear feet (a
+        // climb or descent is under way), a rear foot is not close to an obstacle, and
+        // the base shifts
+        // past the front feet's neutral (their legs reach back) to the first length at
+        // which a rear wheel pair, rolled forward to its neutral again (foot to neutral),
+        // comes close to one. This is how the rear feet reach a stair's first riser
+        // while the front feet stand on a tread too short to drive along: with the front
+        // feet never behind neutral, the feet of one side stay at least a hip spacing
+        // apart, and on treads shorter than that no footprint puts a rear foot at the
+        // riser and a front foot on a tread.
+        let far_rear = [2, 3].map(|r| !near[r]);
+        let split = [0, 1].iter().any(|&f| {
+            [2, 3]
+                .iter()
+                .any(|&r| (feet.h[f] - feet.h[r]).abs() > self.config.max_foot_height_diff_m)
+        });
+        let stairs = self.config.step_model == StepModel::Stairs;
+        // (A shift the longitudinal base shift above already offers is left out.)
+        if stairs
+            && split
+            && far_rear.iter().any(|&f| f)
+            && let Some(l) = self.rear_approach_shift(s, &o, &feet, far_rear, heading, bin)
+            && !(o[0] > 0 && o[1] > 0 && l <= o[0].min(o[1]))
+        {
+            self.push_base_shift(s, &o, &feet, l);
+        }
+
         // Front wheel pairs forward, preparing a rear step: when a rear foot is close to
         // an obstacle (Sec. V). One move per foot, as far as the leg reaches and the
         // wheels can drive (at least `foot_move_increment_m`): shorter moves would only
@@ -1196,15 +1245,179 @@ impl<'c> HybridGraph<'c> {
         }
     }
 
-    /// Whether the CoM estimate ([`com_estimate`]) of state `s` standing for the step at
-    /// leg height `height` ([`StandingRule::step_posture`]) lies in the support triangle
-    /// of a step of
-    /// `leg` to `post` (x, y) with at least `step_support_margin_m`: the triangle of the
-    /// other three feet, the partner on the stepping side driven toward the centre as far
-    /// as the generator may (`max_wheel_to_centre_m`, keeping `wheel_gap_m` to the
-    /// stepping foot at both ends, stopping before untraversable cells and height
-    /// changes), as in Sec. VI-A. Roll and a base shift align the rest.
+    /// The support pre-check of a step of `leg` from state `s` (feet `feet`) to `post`
+    /// at leg height `height` (the first the standing rule gives), run before the
+    /// generator's own check ([`expand::step_motion`]), which decides. With
+    /// [`StepModel::Paper`], [`Self::unaligned_support`]. With [`StepModel::Stairs`],
+    /// the generator's lift keyframe followed through its alignments (Sec. VI-A), where
+    /// most failing steps fail:
+    /// - the stance by the rule ([`crate::motion::standing::level_posture`], the step's
+    ///   pitch), its CoM estimate ([`com_estimate`]);
+    /// - the partner wheel on the stepping side toward the centre as far as
+    ///   longitudinal alignment wants (the support centroid level with the CoM along the
+    ///   heading, Fig. 12a) and as the generator may (`max_wheel_to_centre_m`,
+    ///   `wheel_gap_m` to the stepping foot at both ends, stopping before untraversable
+    ///   cells and height changes of 2 cm, backing off where the partner's leg does not
+    ///   reach);
+    /// - for the roll that takes the CoM none, half or all of the way sideways to the
+    ///   support centroid (eqs. 6–8, one step of the generator's iteration, within
+    ///   `max_roll_rad`), and a base shift of none, half or all of the rest along (at
+    ///   most `max_base_shift_m`): the placed foot within its leg's reach of the rolled,
+    ///   shifted hip, and the lift keyframe's CoM (the foot raised to the swing height,
+    ///   moved rigidly by the roll's and the shift's share) in the support triangle with
+    ///   the planner's margin.
+    ///
+    /// On a building-code staircase the paper's pre-check rejected half of the steps it
+    /// saw that the generator then expanded: a rear step needs the roll.
     fn step_supported(
+        &self,
+        s: LatticeState,
+        feet: &Feet,
+        leg: usize,
+        post: [f64; 3],
+        height: f64,
+    ) -> bool {
+        if self.config.step_model == StepModel::Paper {
+            return self.unaligned_support(s, feet, leg, post, height);
+        }
+        let p = self.lattice.pose(s);
+        let (hx, hy) = self.heading(s.theta);
+        let bin = self.bin(s.theta);
+        let along = |q: [f64; 2]| (q[0] - p.x) * hx + (q[1] - p.y) * hy;
+        let lateral = |q: [f64; 2]| -(q[0] - p.x) * hy + (q[1] - p.y) * hx;
+        let partner = Leg::ALL[leg].same_side_partner().index();
+        let pj = feet.pos[partner];
+        let (ai, ap) = (along(feet.pos[leg]), along([post[0], post[1]]));
+        let aj = along(pj);
+        let c = &self.config;
+        let robot = &self.robot;
+        let pre = Self::feet_xyz(feet);
+        let StepStance { pitch, ground, .. } =
+            c.motion.standing.step_stance(&pre, leg, post, p.theta);
+        let rpy = [0.0, pitch, p.theta];
+        let xy = [p.x, p.y];
+        let all = [true; 4];
+        let stance = level_posture(robot, pre, all, xy, rpy, height, ground);
+        let Ok(com0) = com_estimate(robot, &stance) else {
+            return true;
+        };
+        let sign = if partner < 2 { -1.0 } else { 1.0 };
+        let others: f64 =
+            (0..4).filter(|&k| k != leg && k != partner).map(|k| along(feet.pos[k])).sum();
+        let wanted =
+            ((3.0 * along(com0) - others - aj) * sign).clamp(0.0, c.motion.max_wheel_to_centre_m);
+        let gap = if partner < 2 {
+            aj - (ai.max(ap) + c.motion.wheel_gap_m)
+        } else {
+            (ai.min(ap) - c.motion.wheel_gap_m) - aj
+        };
+        let d = wanted.min(gap.max(0.0));
+        let res = self.lattice.resolution;
+        let hj = feet.h[partner];
+        let mut moved_d = 0.0;
+        while moved_d + res <= d + 1e-9 {
+            let e = moved_d + res;
+            match self.cell(pj[0] + sign * e * hx, pj[1] + sign * e * hy, bin) {
+                Ok((_, h)) if (h - hj).abs() < 0.02 => moved_d = e,
+                _ => break,
+            }
+        }
+        // ... and as far as the partner's leg reaches (the generator backs off too).
+        let moved_by = |e: f64| {
+            let mut moved = pre;
+            moved[partner] = [pj[0] + sign * e * hx, pj[1] + sign * e * hy, hj];
+            moved
+        };
+        let reach_margin = c.motion.standing.reach_margin_m;
+        let (moved, com1) = loop {
+            let moved = moved_by(moved_d);
+            let down = level_posture(robot, moved, all, xy, rpy, height, ground);
+            match solve_chains(robot, &down, reach_margin) {
+                Ok(legs) => break (moved, EstimatedCom { robot }.com_of_solved(&legs)),
+                // Not even the unmoved stance: the generator decides.
+                Err(_) if moved_d <= 0.0 => return true,
+                Err(_) => moved_d = (moved_d - res).max(0.0),
+            }
+        };
+        let support: Vec<[f64; 2]> =
+            (0..4).filter(|&k| k != leg).map(|k| [moved[k][0], moved[k][1]]).collect();
+        let stc = [
+            support.iter().map(|q| q[0]).sum::<f64>() / 3.0,
+            support.iter().map(|q| q[1]).sum::<f64>() / 3.0,
+        ];
+        let swing_z =
+            c.motion.standing.swing_z(robot, self.maps.heights(), pre[leg], post, p.theta);
+        let mut lift_feet = moved;
+        lift_feet[leg] = [pre[leg][0], pre[leg][1], swing_z];
+        let mut contact = all;
+        contact[leg] = false;
+        let lift = level_posture(robot, lift_feet, contact, xy, rpy, height, ground);
+        // A lifted foot out of reach at this height: the generator tries the next.
+        let Ok(com_lift) = com_estimate(robot, &lift) else {
+            return true;
+        };
+        let axes = [[hx, hy], [-hy, hx]];
+        let required = c.step_support_margin_m;
+        let com1_xy = [com1[0], com1[1]];
+        let sideways = lateral(stc) - lateral(com1_xy);
+        // The roll of eqs. 6–8 that takes the CoM `rf` of the way sideways (one step of
+        // the generator's iteration, within its limit): the placed foot must be within
+        // the leg's reach of its hip in the rolled posture (ankle above the wheel
+        // contact), the base shifted.
+        let y_rot = moved.iter().map(|f| lateral([f[0], f[1]])).sum::<f64>() / 4.0;
+        let z_rot = (0..4).filter(|&k| k != leg).map(|k| moved[k][2]).sum::<f64>() / 3.0;
+        let side = |a: usize, b: usize| {
+            (lateral([moved[a][0], moved[a][1]]) + lateral([moved[b][0], moved[b][1]])) / 2.0
+        };
+        let width = (side(0, 2) - side(1, 3)).abs();
+        let mut placed = moved;
+        placed[leg] = post;
+        let ankle = [post[0], post[1], post[2] + robot.foot_length + robot.wheel_radius];
+        let reach = robot.thigh_length + robot.shin_length - reach_margin;
+        ALIGNMENT_FRACTIONS.iter().any(|&rf| {
+            let dl = rf * sideways;
+            let roll = if rf == 0.0 {
+                0.0
+            } else {
+                let target = lateral(com1_xy) + dl;
+                match roll_for_lateral_com(
+                    [y_rot, z_rot],
+                    [lateral(com1_xy), com1[2]],
+                    target,
+                    width,
+                ) {
+                    Ok(sol) => sol.roll.clamp(-c.motion.max_roll_rad, c.motion.max_roll_rad),
+                    Err(_) => return false,
+                }
+            };
+            let rolled =
+                level_posture(robot, placed, all, xy, [roll, pitch, p.theta], height, ground);
+            let hip = hips_in_world(robot, &rolled)[leg];
+            let rest = along(stc) - along(com1_xy);
+            let shifts: &[f64] = if rest.abs() > 0.02 { &ALIGNMENT_FRACTIONS } else { &[0.0] };
+            shifts.iter().any(|&f| {
+                let da = f * rest.clamp(-c.motion.max_base_shift_m, c.motion.max_base_shift_m);
+                let (dx, dy) = (ankle[0] - (hip[0] + hx * da), ankle[1] - (hip[1] + hy * da));
+                if norm2(norm2(dx, dy), ankle[2] - hip[2]) > reach {
+                    return false;
+                }
+                let point = [
+                    com_lift[0] + axes[0][0] * da + axes[1][0] * dl,
+                    com_lift[1] + axes[0][1] * da + axes[1][1] * dl,
+                ];
+                stability_margin(&support, point) >= required
+            })
+        })
+    }
+
+    /// [`StepModel::Paper`]'s support pre-check: whether the CoM estimate of state `s`
+    /// standing for the step at leg height `height` ([`StandingRule::step_posture`])
+    /// lies in the support triangle of a step of `leg` to `post` with at least
+    /// `step_support_margin_m`: the triangle of the other three feet, the partner on the
+    /// stepping side driven toward the centre as far as the generator may
+    /// (`max_wheel_to_centre_m`, keeping `wheel_gap_m` to the stepping foot at both
+    /// ends, stopping before untraversable cells and height changes of 2 cm).
+    fn unaligned_support(
         &self,
         s: LatticeState,
         feet: &Feet,
@@ -1221,15 +1434,12 @@ impl<'c> HybridGraph<'c> {
         let (ai, ap) = (along(feet.pos[leg]), along([post[0], post[1]]));
         let aj = along(pj);
         let c = &self.config;
-        // Toward the centre: a front partner moves back, a rear one forward.
         let d = if partner < 2 {
             (aj - (ai.max(ap) + c.motion.wheel_gap_m)).clamp(0.0, c.motion.max_wheel_to_centre_m)
         } else {
             ((ai.min(ap) - c.motion.wheel_gap_m) - aj).clamp(0.0, c.motion.max_wheel_to_centre_m)
         };
         let sign = if partner < 2 { -1.0 } else { 1.0 };
-        // The wheels stop, as the generator's do, before untraversable cells and height
-        // changes of 2 cm.
         let res = self.lattice.resolution;
         let hj = feet.h[partner];
         let mut moved_d = 0.0;
@@ -1263,6 +1473,47 @@ impl<'c> HybridGraph<'c> {
             .standing
             .stand(&self.robot, self.maps.leg_terrain(), Self::feet_xyz(feet), xy, p.theta)
             .is_ok()
+    }
+
+    /// The rear-step approach's shift (see `special_successors`): the fewest cells `l`
+    /// the base can shift forward over the standing feet (every cell of the way standing
+    /// by the rule, every leg within its offset reach afterwards) after which a rear foot
+    /// of `far` (RL, RR) rolled forward by `l` cells over drivable cells is close to an
+    /// obstacle (criterion 1).
+    fn rear_approach_shift(
+        &self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        far: [bool; 2],
+        heading: (f64, f64),
+        bin: HeadingBin,
+    ) -> Option<i8> {
+        let res = self.lattice.resolution;
+        // Every offset drops by l: the leg with the least room behind it bounds l.
+        let max = (0..4).map(|k| i32::from(o[k]) - i32::from(self.reach[k][0])).min()?;
+        let max = i8::try_from(max.clamp(0, i32::from(i8::MAX))).ok()?;
+        for l in 1..=max {
+            if !self.shift_in_reach(s, feet, l) {
+                return None;
+            }
+            let d = f64::from(l) * res;
+            let close = [2, 3].into_iter().filter(|&r| far[r - 2]).any(|r| {
+                let p = feet.pos[r];
+                let q = [p[0] + heading.0 * d, p[1] + heading.1 * d];
+                self.near_obstacle(q, bin)
+                    && self.drive_line_cost(p, heading, i32::from(l), bin).is_some()
+            });
+            if close {
+                // Where the front wheel pairs could roll as far, driving does the same:
+                // the shift is offered only where a front foot's way ahead is blocked.
+                let blocked = [0, 1].into_iter().any(|f| {
+                    self.drive_line_cost(feet.pos[f], heading, i32::from(l), bin).is_none()
+                });
+                return blocked.then_some(l);
+            }
+        }
+        None
     }
 
     /// A base shift by `l` cells over the standing feet (see the module docs).
