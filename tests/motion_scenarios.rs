@@ -160,16 +160,19 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
     // naming it and its leg.
     let robot = sim.robot().clone();
     let prep = plan::prepare(&s, &robot, None, None, None).expect("maps");
-    // 15 cm: the four-wheel postures before it keep more (about 0.3 m), no three-wheel
-    // posture can (its best: 0.1 m).
-    let options = MotionOptions { min_margin_m: 0.15, ..MotionOptions::from_params(&prep.params) };
+    // 25 cm: the four-wheel postures before it keep more (about 0.3 m), no three-wheel
+    // posture can: the support triangles the feet can form have inscribed circles of at
+    // most about 0.24 m. (At 15 cm, since the swing clears only what the wheels pass and
+    // the partner wheel stops within its leg's reach, a candidate of the generator's full
+    // search keeps the margin.)
+    let options = MotionOptions { min_margin_m: 0.25, ..MotionOptions::from_params(&prep.params) };
     let first = p.path.iter().position(|e| e.kind == PathKind::Step).expect("a step");
     match expand_path(&p.path[..=first], &robot, &prep.maps, &mut sim, &options) {
         Err(MotionError::Step { index, leg, best_margin_m, required_m, .. }) => {
             assert_eq!(index, first);
             assert_eq!(Some(leg), p.path[first].leg);
             // (The best margin is read back from a message printed to the millimetre.)
-            assert!(best_margin_m <= required_m && required_m == 0.15, "{best_margin_m}");
+            assert!(best_margin_m <= required_m && required_m == 0.25, "{best_margin_m}");
         }
         other => panic!("expected a step failure, got {other:?}"),
     }

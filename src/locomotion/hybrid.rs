@@ -1314,14 +1314,7 @@ impl<'c> HybridGraph<'c> {
         let d = wanted.min(gap.max(0.0));
         let res = self.lattice.resolution;
         let hj = feet.h[partner];
-        let mut moved_d = 0.0;
-        while moved_d + res <= d + 1e-9 {
-            let e = moved_d + res;
-            match self.cell(pj[0] + sign * e * hx, pj[1] + sign * e * hy, bin) {
-                Ok((_, h)) if (h - hj).abs() < 0.02 => moved_d = e,
-                _ => break,
-            }
-        }
+        let mut moved_d = self.partner_roll(pj, hj, [sign * hx, sign * hy], d, bin);
         // ... and as far as the partner's leg reaches (the generator backs off too).
         let moved_by = |e: f64| {
             let mut moved = pre;
@@ -1440,16 +1433,7 @@ impl<'c> HybridGraph<'c> {
             ((ai.min(ap) - c.motion.wheel_gap_m) - aj).clamp(0.0, c.motion.max_wheel_to_centre_m)
         };
         let sign = if partner < 2 { -1.0 } else { 1.0 };
-        let res = self.lattice.resolution;
-        let hj = feet.h[partner];
-        let mut moved_d = 0.0;
-        while moved_d + res <= d + 1e-9 {
-            let e = moved_d + res;
-            match self.cell(pj[0] + sign * e * hx, pj[1] + sign * e * hy, bin) {
-                Ok((_, h)) if (h - hj).abs() < 0.02 => moved_d = e,
-                _ => break,
-            }
-        }
+        let moved_d = self.partner_roll(pj, feet.h[partner], [sign * hx, sign * hy], d, bin);
         let moved = [pj[0] + sign * moved_d * hx, pj[1] + sign * moved_d * hy];
         let support: Vec<[f64; 2]> = (0..4)
             .filter(|&k| k != leg)
@@ -1459,6 +1443,22 @@ impl<'c> HybridGraph<'c> {
         let stance = c.motion.standing.step_posture(&self.robot, pre, leg, post, &p, height);
         com_estimate(&self.robot, &stance)
             .is_ok_and(|com| stability_margin(&support, com) >= c.step_support_margin_m)
+    }
+
+    /// How far the partner wheel at `pj` (ground `hj`) rolls along `dir` (the heading
+    /// times `sign`), up to `d`, in cells: the generator's wheels stop before
+    /// untraversable cells and height changes of 2 cm.
+    fn partner_roll(&self, pj: [f64; 2], hj: f64, dir: [f64; 2], d: f64, bin: HeadingBin) -> f64 {
+        let res = self.lattice.resolution;
+        let mut moved_d = 0.0;
+        while moved_d + res <= d + 1e-9 {
+            let e = moved_d + res;
+            match self.cell(pj[0] + dir[0] * e, pj[1] + dir[1] * e, bin) {
+                Ok((_, h)) if (h - hj).abs() < 0.02 => moved_d = e,
+                _ => break,
+            }
+        }
+        moved_d
     }
 
     /// Whether the robot can stand by the rule with its base `l` cells ahead of state

@@ -518,7 +518,8 @@ impl<'a> Expander<'a> {
         let along = |f: [f64; 3]| c * f[0] + s * f[1];
         let lateral = |f: [f64; 3]| -s * f[0] + c * f[1];
         let pre = self.cur.feet;
-        let StepStance { pitch, ground, .. } = self.o.standing.step_stance(&pre, i, post_foot, yaw);
+        let stance = self.o.standing.step_stance(&pre, i, post_foot, yaw);
+        let StepStance { pitch, ground, .. } = stance;
         let xy = self.xy();
         let all = [true; 4];
 
@@ -617,7 +618,9 @@ impl<'a> Expander<'a> {
             (roll, com) = (r, c);
         }
 
-        Ok(Alignment { height, d, wanted, moved, roll, com, stc })
+        // What a base shift would have to take along (Fig. 12b).
+        let rest = along(stc) - along(com);
+        Ok(Alignment { height, stance, d, wanted, moved, roll, rest })
     }
 
     /// Builds the keyframes of one step candidate from its alignment, the foot carried
@@ -630,21 +633,18 @@ impl<'a> Expander<'a> {
         aligned: &Alignment,
         shift: Shift,
     ) -> Vec<Planned> {
-        let o = *self.o;
-        let i = leg.index();
-        let j = leg.same_side_partner().index();
+        let Alignment { height, stance, d, wanted, moved, roll, rest } = *aligned;
+        let StepStance { post, pitch, ground } = stance;
+        let (i, j) = (leg.index(), leg.same_side_partner().index());
         let yaw = self.cur.base_rpy[2];
-        let (s, c) = yaw.sin_cos();
-        let along = |f: [f64; 3]| c * f[0] + s * f[1];
-        let pre = self.cur.feet;
-        let StepStance { post, pitch, ground } =
-            self.o.standing.step_stance(&pre, i, post_foot, yaw);
         let pitch_post = self.pitch_for(&post, yaw);
+        let (s, c) = yaw.sin_cos();
+        let max_shift = self.o.max_base_shift_m;
+        let pre = self.cur.feet;
         let xy = self.xy();
         let all = [true; 4];
         let mut lifted = all;
         lifted[i] = false;
-        let Alignment { height, d, wanted, moved, roll, com, stc } = *aligned;
 
         // Longitudinal remainder: base shift (Fig. 12b).
         // Only when the wheel could not go as far as alignment wanted (blocked, or a
@@ -652,14 +652,13 @@ impl<'a> Expander<'a> {
         let hindered = d + 1e-3 < wanted;
         let shift = match shift {
             Shift::Remainder(fraction) => {
-                let rem = along(stc) - along(com);
-                if hindered && rem.abs() > 0.02 {
-                    fraction * rem.clamp(-o.max_base_shift_m, o.max_base_shift_m)
+                if hindered && rest.abs() > 0.02 {
+                    fraction * rest.clamp(-max_shift, max_shift)
                 } else {
                     0.0
                 }
             }
-            Shift::Fixed(m) => m.clamp(-o.max_base_shift_m, o.max_base_shift_m),
+            Shift::Fixed(m) => m.clamp(-max_shift, max_shift),
         };
         let xy_shift = [xy[0] + shift * c, xy[1] + shift * s];
 
@@ -928,6 +927,8 @@ type AlignmentKey = (f64, f64, f64);
 struct Alignment {
     /// Leg height of the standing rule, m.
     height: f64,
+    /// How the step is stood ([`crate::motion::standing::StandingRule::step_stance`]).
+    stance: StepStance,
     /// How far the partner wheel moves toward the centre, m.
     d: f64,
     /// How far longitudinal alignment wanted it to move, m.
@@ -936,10 +937,9 @@ struct Alignment {
     moved: [[f64; 3]; 4],
     /// Base roll, rad.
     roll: f64,
-    /// CoM after the roll.
-    com: [f64; 3],
-    /// Centroid of the support triangle (x, y).
-    stc: [f64; 3],
+    /// From the CoM after the roll to the support triangle's centroid along the
+    /// heading, m: what a base shift would take up.
+    rest: f64,
 }
 
 /// The longitudinal base shift of a step candidate.
