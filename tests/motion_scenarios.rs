@@ -162,9 +162,8 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
     let prep = plan::prepare(&s, &robot, None, None, None).expect("maps");
     // 25 cm: the four-wheel postures before it keep more (about 0.3 m), no three-wheel
     // posture can: the support triangles the feet can form have inscribed circles of at
-    // most about 0.24 m. (At 15 cm, since the swing clears only what the wheels pass and
-    // the partner wheel stops within its leg's reach, a candidate of the generator's full
-    // search keeps the margin.)
+    // most about 0.24 m. (At 15 cm, since the swing clears only what the wheels pass, a
+    // candidate of the generator's full search keeps the margin.)
     let options = MotionOptions { min_margin_m: 0.25, ..MotionOptions::from_params(&prep.params) };
     let first = p.path.iter().position(|e| e.kind == PathKind::Step).expect("a step");
     match expand_path(&p.path[..=first], &robot, &prep.maps, &mut sim, &options) {

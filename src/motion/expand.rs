@@ -68,7 +68,7 @@ use crate::cost::CostMaps;
 use crate::feasibility::{DrivingCheck, Infeasible};
 use crate::geometry::{Pose2, wrap_angle};
 use crate::jobs::plan::{PathElement, PathKind};
-use crate::params::Params;
+use crate::params::{Params, StepModel};
 use crate::robot::{Leg, RobotDescription};
 
 /// Constants of the expansion.
@@ -76,6 +76,11 @@ use crate::robot::{Leg, RobotDescription};
 pub struct MotionOptions {
     /// Minimum static stability margin at every keyframe and interpolated point, m.
     pub min_margin_m: f64,
+    /// With [`StepModel::Stairs`] the partner wheel stops where its leg leaves reach
+    /// (a shorter move, the rest to roll and shift); with the paper's model a candidate
+    /// whose wheel move leaves reach fails, as before (the shorter move admitted steps
+    /// with less margin to the executor's lift guard on three generated courses).
+    pub step_model: StepModel,
     /// The standing leg-height rule (Sec. VI-B), the one the planner checks reach with.
     pub standing: StandingRule,
     /// Driving leg height (Sec. VI-B), m.
@@ -109,6 +114,7 @@ impl MotionOptions {
     pub fn from_params(params: &Params) -> Self {
         Self {
             min_margin_m: params.min_stability_margin_m,
+            step_model: params.step_model,
             standing: StandingRule::from_params(params),
             driving_leg_height_m: params.driving_leg_height_m,
             base_circle_radius_m: params.base_circle_radius_m,
@@ -558,9 +564,9 @@ impl<'a> Expander<'a> {
             }
             d = e;
         }
-        // ... and as far as the partner's leg reaches at this stance: a wheel driven past
-        // it would fail the step, where a shorter move leaves the rest to the roll and the
-        // base shift.
+        // ... and, with the stairs step model, as far as the partner's leg reaches at this
+        // stance: a wheel driven past it would fail the step, where a shorter move leaves
+        // the rest to the roll and the base shift.
         let moved_by = |d: f64| {
             let mut moved = pre;
             if d > 0.0 {
@@ -570,7 +576,7 @@ impl<'a> Expander<'a> {
             moved
         };
         let mut moved = moved_by(d);
-        while d > 0.0 {
+        while d > 0.0 && self.o.step_model == StepModel::Stairs {
             let p = self.standing(moved, all, xy, yaw, pitch, 0.0, height, ground);
             if solve_chains(self.robot, &p, self.o.standing.reach_margin_m).is_ok() {
                 break;
