@@ -249,8 +249,6 @@ pub struct HybridConfig {
     pub max_oriented_nodes: usize,
     /// Smallest stability margin of a posture, m (the generator's requirement).
     pub min_stability_margin_m: f64,
-    /// How steps are prepared and pre-checked ([`StepModel`]).
-    pub step_model: StepModel,
     /// [`StepModel::Paper`]'s pre-check: the least margin of the CoM estimate in a
     /// step's support triangle at the unaligned stance, m.
     pub step_support_margin_m: f64,
@@ -297,7 +295,6 @@ impl HybridConfig {
             max_footprints: 65_536,
             max_oriented_nodes: super::cost_to_go::MAX_ORIENTED_NODES,
             min_stability_margin_m: params.min_stability_margin_m,
-            step_model: params.step_model,
             step_support_margin_m: params.step_support_margin_m,
             motion: {
                 let mut m = MotionOptions::from_params(params);
@@ -1088,7 +1085,7 @@ impl<'c> HybridGraph<'c> {
                 .iter()
                 .any(|&r| (feet.h[f] - feet.h[r]).abs() > self.config.max_foot_height_diff_m)
         });
-        let stairs = self.config.step_model == StepModel::Stairs;
+        let stairs = self.config.motion.step_model == StepModel::Stairs;
         // (A shift the longitudinal base shift above already offers is left out.)
         if stairs
             && split
@@ -1277,7 +1274,7 @@ impl<'c> HybridGraph<'c> {
         post: [f64; 3],
         height: f64,
     ) -> bool {
-        if self.config.step_model == StepModel::Paper {
+        if self.config.motion.step_model == StepModel::Paper {
             return self.unaligned_support(s, feet, leg, post, height);
         }
         let p = self.lattice.pose(s);
