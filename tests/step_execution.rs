@@ -141,9 +141,17 @@ fn stepped(s: &RunSummary) -> Vec<Leg> {
         .collect()
 }
 
+/// The 1-based number, in plan order, of the first step of `leg` onto higher ground.
+fn first_step_up(p: &PlanSummary, leg: Leg) -> usize {
+    let steps = p.path.iter().filter(|e| e.kind == PathKind::Step);
+    1 + steps
+        .take_while(|e| !(e.leg == Some(leg) && e.step.is_some_and(|s| s.height_m > 0.05)))
+        .count()
+}
+
 #[test]
 fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
-    // Step 1 of the platform prefix is the front-left step up onto the platform: 1 s into
+    // The front-left step up onto the platform: 1 s into
     // its swing, the base is pushed to the left, toward the lifted foot, for 0.3 s. The
     // robot is stiff, so the static margin hardly changes until the push lifts a support
     // wheel: then the measured support shrinks and the margin falls below zero. The
@@ -152,8 +160,11 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
     let sc = common::scenario("platform");
     // 300 N: 150 N leaves the 20 cm margin at 19 cm; 400 N keeps wheels off for 1.9 s
     // and the step is aborted.
+    let robot = Simulation::robot_only(&common::model()).expect("model").robot().clone();
+    let step =
+        first_step_up(&plan::run(&sc, &robot, &plan_options()).expect("plan"), Leg::FrontLeft);
     let push = Push {
-        when: PushWhen::Step { step: 1, phase: Phase::Swing, delay_s: 1.0 },
+        when: PushWhen::Step { step, phase: Phase::Swing, delay_s: 1.0 },
         force: [0.0, 300.0, 0.0],
         duration_s: 0.3,
     };

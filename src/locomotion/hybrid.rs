@@ -14,7 +14,13 @@
 //!   cheapest end position, the only one returned.
 //! - **longitudinal base shift** (Fig. 6b): when both front feet stand ahead of neutral,
 //!   the base moves forward over the standing feet until one front foot is neutral or a
-//!   rear leg reaches its reach limit. Cost C_BS = k10 · L_BS · C_B,avg.
+//!   rear leg reaches its reach limit. Cost C_BS = k10 · L_BS · C_B,avg. A rear leg at
+//!   its limit can stand but not step (the step's stance pitches the base less), so
+//!   where a rear foot close to an obstacle could not step after the full shift, the
+//!   shift ends at the longest length from which it can
+//!   (`HybridGraph::rear_step_ready_shift`); otherwise a square approach to a 0.186 m
+//!   block left both rear feet stranded and the plan climbed diagonally at ten times
+//!   the cost.
 //! - **front foot forward** (Fig. 6c): when a rear foot is close to an obstacle, a front
 //!   wheel pair drives forward (keeping ground contact), preparing a rear step — as far
 //!   as its leg reaches and the terrain is drivable, in one move. Cost C_FM (eq. 6).
@@ -1064,6 +1070,13 @@ impl<'c> HybridGraph<'c> {
             while l < max && self.shift_in_reach(s, &feet, l + 1) {
                 l += 1;
             }
+            // The paper's shift ends where a rear leg reaches its full length. A rear leg
+            // at full length cannot also lift its foot over an edge (its step stance
+            // pitches the base less), so where a rear foot close to an obstacle could not
+            // step from there, the shift ends earlier, where it can.
+            if let Some(ready) = self.rear_step_ready_shift(s, &o, near, l) {
+                l = ready;
+            }
             if l > 0 {
                 self.push_base_shift(s, &o, &feet, l);
             }
@@ -1470,6 +1483,67 @@ impl<'c> HybridGraph<'c> {
             .standing
             .stand(&self.robot, self.maps.leg_terrain(), Self::feet_xyz(feet), xy, p.theta)
             .is_ok()
+    }
+
+    /// The longest base shift of at most `max` cells from state `s` (offsets `o`) after
+    /// which a rear leg close to an obstacle (`near`, criterion 1; the feet stay where
+    /// they stand, so it holds before and after) keeps every leg in reach while it steps
+    /// to its cheapest foothold ([`StandingRule::step_heights`] yields a height): `None`
+    /// when no rear foot is close to an obstacle or no such shift exists. The shift's
+    /// other checks (stability, the generator's) stay with the step itself.
+    fn rear_step_ready_shift(
+        &self,
+        s: LatticeState,
+        o: &FootOffsets,
+        near: [bool; 4],
+        max: i8,
+    ) -> Option<i8> {
+        if !near[2] && !near[3] {
+            return None;
+        }
+        let res = self.lattice.resolution;
+        let (hx, hy) = self.heading(s.theta);
+        let p = self.lattice.pose(s);
+        (1..=max).rev().find(|&l| {
+            let d = f64::from(l) * res;
+            let Some(cell) = self.lattice.state(&Pose2::new(p.x + hx * d, p.y + hy * d, p.theta))
+            else {
+                return false;
+            };
+            let t = LatticeState { i: cell.i, j: cell.j, ..s };
+            let o2 = o.map(|v| v - l);
+            let Some(feet) = self.feet_of(t, &o2) else {
+                return false;
+            };
+            [2, 3]
+                .into_iter()
+                .filter(|&r| near[r])
+                .any(|r| self.rear_step_reaches(t, &o2, &feet, r))
+        })
+    }
+
+    /// Whether rear leg `r` at state `t` (offsets `o`, feet `feet`) keeps every leg in
+    /// reach through a step to its cheapest foothold by the scan.
+    fn rear_step_reaches(&self, t: LatticeState, o: &FootOffsets, feet: &Feet, r: usize) -> bool {
+        let Some(&(_, _, _, post)) = self.step_candidates(t, o, feet, r).first() else {
+            return false;
+        };
+        let pose = self.lattice.pose(t);
+        self.config
+            .motion
+            .standing
+            .step_heights(
+                &self.robot,
+                self.maps.heights(),
+                self.maps.leg_terrain(),
+                Self::feet_xyz(feet),
+                r,
+                post,
+                [pose.x, pose.y],
+                pose.theta,
+            )
+            .next()
+            .is_some()
     }
 
     /// The rear-step approach's shift (see `special_successors`): the fewest cells `l`
