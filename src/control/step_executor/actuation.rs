@@ -17,7 +17,7 @@ pub fn rolling_wheel_speed(robot: &RobotDescription, v: [f64; 2], yaw: f64) -> f
 }
 
 /// Spare reach the executor keeps when it has to pull a foot in, m.
-const REACH_SPARE_M: f64 = 0.001;
+pub(super) const REACH_SPARE_M: f64 = 0.001;
 
 /// Joint targets for `p` like `motion::kinematics::leg_joint_targets`, except that a foot
 /// beyond a leg's reach is pulled toward its hip (along the hip–ankle line) until the leg
@@ -63,6 +63,23 @@ pub fn reachable_leg_targets(
         q[leg.index()] = leg_ik(robot, leg, contact, pitch)?;
     }
     Ok(q)
+}
+
+/// How far the furthest-reaching leg in contact of posture `p`, `except` left out, asks
+/// beyond its reach (thigh plus shin, less `spare`), m; zero or less when every such foot
+/// is reached. [`reachable_leg_targets`] would pull such a foot in, off the ground.
+pub fn reach_excess(robot: &RobotDescription, p: &Posture, spare: f64, except: Leg) -> f64 {
+    let local = contacts_in_base(robot, p);
+    let reach = robot.thigh_length + robot.shin_length - spare;
+    Leg::ALL
+        .into_iter()
+        .filter(|&leg| p.contact[leg.index()] && leg != except)
+        .map(|leg| {
+            let c = local[leg.index()];
+            let ankle = ankle_of_contact(robot, [c[0], c[2]], p.base_rpy[1]);
+            ankle[0].hypot(ankle[1]) - reach
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
 }
 
 fn straight(speed: f64) -> WheelPairCommand {

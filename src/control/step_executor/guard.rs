@@ -1,10 +1,11 @@
 //! The lift margin guard: before a foot is lifted, the support margin measured from
 //! MuJoCo must reach the lift threshold plus reserve (more per retry); if it does not, the
 //! base is moved toward the support centroid in bounded increments (a base shift
-//! longitudinally, a roll about the ground laterally: [`correction_roll`]), else the step
-//! is aborted. At the lift the landing offset ([`landing_offset`]) of the swing foot is
-//! frozen.
+//! longitudinally, a roll about the ground laterally: [`correction_roll`]) as far as the
+//! planted legs reach (`StepExecutor::within_reach`), else the step is aborted. At the
+//! lift the landing offset ([`landing_offset`]) of the swing foot is frozen.
 
+use super::actuation::{REACH_SPARE_M, reach_excess};
 use super::timing::smoothstep;
 use super::{
     ActiveStep, Command, ExecEventKind, ExecFailure, Mode, Observation, StepExecutor, planar,
@@ -41,7 +42,38 @@ pub fn correction_roll(p: &Posture, correction: [f64; 2]) -> f64 {
     -lat / h
 }
 
+/// The smallest correction increment worth making, m: below it the legs' reach has
+/// stopped the base.
+const MIN_CORRECTION_M: f64 = 0.002;
+
 impl StepExecutor {
+    /// The correction on the way from `from` to `to` that goes furthest while no support
+    /// leg in contact (all but `lifting`, whose foot leaves the ground anyway) asks more
+    /// reach than it does at `from` (or than it has): a base moved over planted feet
+    /// beyond a leg's reach would have that foot pulled in, off the ground, and the
+    /// support the correction was meant to widen would shrink instead (measured on a step
+    /// down: a rear wheel lifted, the margin fell from 2.6 cm to −24.5 cm).
+    fn within_reach(&mut self, from: [f64; 2], to: [f64; 2], lifting: Leg) -> [f64; 2] {
+        let mut excess = |c: [f64; 2]| {
+            let saved = self.correction;
+            self.correction = c;
+            let p = self.with_offsets(&self.cmd);
+            self.correction = saved;
+            reach_excess(&self.robot, &p, REACH_SPARE_M, lifting)
+        };
+        let allowed = excess(from).max(0.0);
+        if excess(to) <= allowed {
+            return to;
+        }
+        let at = |a: f64| [from[0] + a * (to[0] - from[0]), from[1] + a * (to[1] - from[1])];
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..20 {
+            let mid = 0.5 * (lo + hi);
+            if excess(at(mid)) <= allowed { lo = mid } else { hi = mid }
+        }
+        at(lo)
+    }
+
     #[allow(clippy::too_many_arguments)]
     pub(super) fn guard_tick(
         &mut self,
@@ -107,6 +139,16 @@ impl StepExecutor {
                 next = next.map(|v| v * c.max_correction_m / len);
             }
             let from = self.correction;
+            let next = self.within_reach(from, next, leg);
+            if (next[0] - from[0]).hypot(next[1] - from[1]) < MIN_CORRECTION_M {
+                // The legs in contact reach no further: the step cannot be stabilised.
+                self.steps_aborted += 1;
+                self.fail(
+                    ExecFailure::StepAborted { leg, margin_m: m, required_m: required },
+                    time,
+                );
+                return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
+            }
             self.correction = next;
             self.event(
                 time,
@@ -147,6 +189,32 @@ mod tests {
         p.feet[0][2] = 0.1;
         p.contact[0] = false;
         assert!((correction_roll(&p, [-0.05, 0.0]) + 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_correction_stops_where_a_planted_leg_would_leave_the_ground() {
+        // Standing 0.5 m high, every leg in contact: a 0.6 m shift of the base over the
+        // planted feet asks the rear legs for more than thigh + shin (0.4 m still
+        // reaches), and the actuation would pull those feet in, off the ground. The
+        // correction stops where the furthest leg just reaches (on a step down a rear
+        // wheel lifted this way and the margin fell from 2.6 to −24.5 cm).
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
+        ex.cmd = standing();
+        let excess = |ex: &mut StepExecutor, c: [f64; 2]| {
+            ex.correction = c;
+            let p = ex.with_offsets(&ex.cmd);
+            let e = reach_excess(&ex.robot, &p, REACH_SPARE_M, Leg::FrontLeft);
+            ex.correction = [0.0; 2];
+            e
+        };
+        assert!(excess(&mut ex, [0.0, 0.0]) < 0.0);
+        assert!(excess(&mut ex, [0.6, 0.0]) > 0.0);
+        let c = ex.within_reach([0.0, 0.0], [0.6, 0.0], Leg::FrontLeft);
+        assert!(c[0] > 0.4 && c[0] < 0.6 && c[1] == 0.0, "{c:?}");
+        assert!(excess(&mut ex, c) <= 0.0);
+        assert!(excess(&mut ex, [c[0] + 0.001, 0.0]) > 0.0);
+        // Within reach, the whole correction is taken.
+        assert_eq!(ex.within_reach([0.0, 0.0], [0.02, 0.01], Leg::FrontLeft), [0.02, 0.01]);
     }
 
     #[test]
