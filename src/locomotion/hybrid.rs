@@ -1485,6 +1485,23 @@ impl<'c> HybridGraph<'c> {
             .is_ok()
     }
 
+    /// The state a base shift of `l` cells from state `s` (offsets `o`) ends in: the base
+    /// on the lattice cell holding the exact shifted position, the same orientation and
+    /// footprint id as `s`, and every foot offset lowered by `l` (the feet stay put).
+    /// `None` off the lattice.
+    fn shifted(
+        &self,
+        s: LatticeState,
+        o: &FootOffsets,
+        l: i8,
+    ) -> Option<(LatticeState, FootOffsets)> {
+        let (hx, hy) = self.heading(s.theta);
+        let p = self.lattice.pose(s);
+        let d = f64::from(l) * self.lattice.resolution;
+        let cell = self.lattice.state(&Pose2::new(p.x + hx * d, p.y + hy * d, p.theta))?;
+        Some((LatticeState { i: cell.i, j: cell.j, ..s }, o.map(|v| v - l)))
+    }
+
     /// The longest base shift of at most `max` cells from state `s` (offsets `o`) after
     /// which a rear leg close to an obstacle (`near`, criterion 1; the feet stay where
     /// they stand, so it holds before and after) keeps every leg in reach while it steps
@@ -1501,17 +1518,10 @@ impl<'c> HybridGraph<'c> {
         if !near[2] && !near[3] {
             return None;
         }
-        let res = self.lattice.resolution;
-        let (hx, hy) = self.heading(s.theta);
-        let p = self.lattice.pose(s);
         (1..=max).rev().find(|&l| {
-            let d = f64::from(l) * res;
-            let Some(cell) = self.lattice.state(&Pose2::new(p.x + hx * d, p.y + hy * d, p.theta))
-            else {
+            let Some((t, o2)) = self.shifted(s, o, l) else {
                 return false;
             };
-            let t = LatticeState { i: cell.i, j: cell.j, ..s };
-            let o2 = o.map(|v| v - l);
             let Some(feet) = self.feet_of(t, &o2) else {
                 return false;
             };
@@ -1607,13 +1617,10 @@ impl<'c> HybridGraph<'c> {
         }
         let cb_avg = sum / f64::from(l + 1);
         let length = f64::from(l) * res;
-        let end = Pose2::new(p.x + hx * length, p.y + hy * length, p.theta);
-        let Some(cell) = self.lattice.state(&end) else {
+        let Some((t, o2)) = self.shifted(s, o, l) else {
             return;
         };
-        let moved = self.lattice.pose(cell).distance(&p);
-        let o2 = o.map(|v| v - l);
-        let t = LatticeState { i: cell.i, j: cell.j, ..s };
+        let moved = self.lattice.pose(t).distance(&p);
         if !self.target_ok(t, &o2) {
             return;
         }

@@ -634,7 +634,6 @@ impl<'a> Expander<'a> {
     fn step_candidate(
         &self,
         leg: Leg,
-        post_foot: [f64; 3],
         swing_z: f64,
         aligned: &Alignment,
         shift: Shift,
@@ -642,6 +641,7 @@ impl<'a> Expander<'a> {
         let Alignment { height, stance, d, wanted, moved, roll, rest } = *aligned;
         let StepStance { post, pitch, ground } = stance;
         let (i, j) = (leg.index(), leg.same_side_partner().index());
+        let post_foot = post[i];
         let yaw = self.cur.base_rpy[2];
         let pitch_post = self.pitch_for(&post, yaw);
         let (s, c) = yaw.sin_cos();
@@ -777,7 +777,7 @@ impl<'a> Expander<'a> {
                     continue;
                 }
             };
-            let seq = self.step_candidate(leg, post_foot, swing_z, &aligned, shift);
+            let seq = self.step_candidate(leg, swing_z, &aligned, shift);
             if tried.contains(&seq) {
                 continue;
             }

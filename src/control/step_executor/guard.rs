@@ -53,13 +53,9 @@ impl StepExecutor {
     /// beyond a leg's reach would have that foot pulled in, off the ground, and the
     /// support the correction was meant to widen would shrink instead (measured on a step
     /// down: a rear wheel lifted, the margin fell from 2.6 cm to −24.5 cm).
-    fn within_reach(&mut self, from: [f64; 2], to: [f64; 2], lifting: Leg) -> [f64; 2] {
-        let mut excess = |c: [f64; 2]| {
-            let saved = self.correction;
-            self.correction = c;
-            let p = self.with_offsets(&self.cmd);
-            self.correction = saved;
-            reach_excess(&self.robot, &p, REACH_SPARE_M, lifting)
+    fn within_reach(&self, from: [f64; 2], to: [f64; 2], lifting: Leg) -> [f64; 2] {
+        let excess = |c: [f64; 2]| {
+            reach_excess(&self.robot, &self.with_correction(&self.cmd, c), REACH_SPARE_M, lifting)
         };
         let allowed = excess(from).max(0.0);
         if excess(to) <= allowed {
@@ -94,10 +90,7 @@ impl StepExecutor {
             corr_from[0] + (target[0] - corr_from[0]) * ramp,
             corr_from[1] + (target[1] - corr_from[1]) * ramp,
         ];
-        let saved = self.correction;
-        self.correction = applied;
-        let p = self.with_offsets(&self.cmd);
-        self.correction = saved;
+        let p = self.with_correction(&self.cmd, applied);
         let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
         let ready = wait >= c.lift_settle_s + if attempts == 0 { 0.0 } else { c.correction_time_s };
         if !ready {
@@ -140,27 +133,22 @@ impl StepExecutor {
             }
             let from = self.correction;
             let next = self.within_reach(from, next, leg);
-            if (next[0] - from[0]).hypot(next[1] - from[1]) < MIN_CORRECTION_M {
-                // The legs in contact reach no further: the step cannot be stabilised.
-                self.steps_aborted += 1;
-                self.fail(
-                    ExecFailure::StepAborted { leg, margin_m: m, required_m: required },
+            // Below the smallest increment the legs in contact reach no further: the step
+            // cannot be stabilised and is aborted below.
+            if (next[0] - from[0]).hypot(next[1] - from[1]) >= MIN_CORRECTION_M {
+                self.correction = next;
+                self.event(
                     time,
+                    ExecEventKind::Correction {
+                        leg,
+                        margin_m: m,
+                        correction_m: next[0].hypot(next[1]),
+                    },
                 );
+                attempts += 1;
+                self.mode = Mode::Guard { index, wait: 0.0, attempts, corr_from: from };
                 return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
             }
-            self.correction = next;
-            self.event(
-                time,
-                ExecEventKind::Correction {
-                    leg,
-                    margin_m: m,
-                    correction_m: next[0].hypot(next[1]),
-                },
-            );
-            attempts += 1;
-            self.mode = Mode::Guard { index, wait: 0.0, attempts, corr_from: from };
-            return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
         }
         self.steps_aborted += 1;
         self.fail(ExecFailure::StepAborted { leg, margin_m: m, required_m: required }, time);
@@ -200,19 +188,15 @@ mod tests {
         // wheel lifted this way and the margin fell from 2.6 to −24.5 cm).
         let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
         ex.cmd = standing();
-        let excess = |ex: &mut StepExecutor, c: [f64; 2]| {
-            ex.correction = c;
-            let p = ex.with_offsets(&ex.cmd);
-            let e = reach_excess(&ex.robot, &p, REACH_SPARE_M, Leg::FrontLeft);
-            ex.correction = [0.0; 2];
-            e
+        let excess = |ex: &StepExecutor, c: [f64; 2]| {
+            reach_excess(&ex.robot, &ex.with_correction(&ex.cmd, c), REACH_SPARE_M, Leg::FrontLeft)
         };
-        assert!(excess(&mut ex, [0.0, 0.0]) < 0.0);
-        assert!(excess(&mut ex, [0.6, 0.0]) > 0.0);
+        assert!(excess(&ex, [0.0, 0.0]) < 0.0);
+        assert!(excess(&ex, [0.6, 0.0]) > 0.0);
         let c = ex.within_reach([0.0, 0.0], [0.6, 0.0], Leg::FrontLeft);
         assert!(c[0] > 0.4 && c[0] < 0.6 && c[1] == 0.0, "{c:?}");
-        assert!(excess(&mut ex, c) <= 0.0);
-        assert!(excess(&mut ex, [c[0] + 0.001, 0.0]) > 0.0);
+        assert!(excess(&ex, c) <= 0.0);
+        assert!(excess(&ex, [c[0] + 0.001, 0.0]) > 0.0);
         // Within reach, the whole correction is taken.
         assert_eq!(ex.within_reach([0.0, 0.0], [0.02, 0.01], Leg::FrontLeft), [0.02, 0.01]);
     }

@@ -231,11 +231,17 @@ impl StepExecutor {
 
     /// The commanded posture with the foot offsets and the correction applied.
     fn with_offsets(&self, p: &Posture) -> Posture {
+        self.with_correction(p, self.correction)
+    }
+
+    /// [`Self::with_offsets`] with the stabilising correction `correction` in place of
+    /// the current one.
+    fn with_correction(&self, p: &Posture, correction: [f64; 2]) -> Posture {
         let mut q = *p;
-        q.base_position[0] += self.correction[0];
-        q.base_position[1] += self.correction[1];
+        q.base_position[0] += correction[0];
+        q.base_position[1] += correction[1];
         q.base_position[2] += self.base_lift;
-        q.base_rpy[0] += correction_roll(p, self.correction);
+        q.base_rpy[0] += correction_roll(p, correction);
         for (f, o) in q.feet.iter_mut().zip(self.foot_offset) {
             for k in 0..3 {
                 f[k] += o[k];
