@@ -104,6 +104,14 @@ pub struct Params {
     /// stability, issue 7): 2 cm, the smallest margin the paper's scenarios expect during
     /// execution.
     pub min_lift_margin_m: f64,
+    /// Margin a step's three support legs need on top of `min_lift_margin_m` while a foot
+    /// is lifted, m: when the foot unloads, the compliant support legs let the CoM sag
+    /// toward it (measured in MuJoCo: 2.5–3 cm on the platform's and the staircase's front
+    /// steps up), which the CoM estimate of a posture leaves out. The executor asks this
+    /// much more before it lifts a foot; the motion generator (and with it the planner's
+    /// step check) asks it of every posture with three feet in contact, so that a planned
+    /// step is one the executor lifts. Ours: 0.03 m.
+    pub lift_margin_reserve_m: f64,
     /// Longest wheel-to-centre move of the stepping side's other wheel pair (Sec. VI-A,
     /// Fig. 12a), m. Ours: 0.45 m.
     pub max_wheel_to_centre_m: f64,
@@ -159,6 +167,7 @@ impl Default for Params {
             base_pitch_slope_fraction: 0.7,
             min_stability_margin_m: 0.03,
             min_lift_margin_m: 0.02,
+            lift_margin_reserve_m: 0.03,
             max_wheel_to_centre_m: 0.45,
             wheel_gap_m: 0.3,
             step_support_margin_m: 0.055,
@@ -265,7 +274,7 @@ impl Params {
                 return Err(InvalidParam { name, value, reason: "must be a finite number > 0" });
             }
         }
-        let non_negative: [(&'static str, f64); 14] = [
+        let non_negative: [(&'static str, f64); 15] = [
             ("k1", self.k1),
             ("k2", self.k2),
             ("k3", self.k3),
@@ -280,6 +289,7 @@ impl Params {
             ("base_pitch_slope_fraction", self.base_pitch_slope_fraction),
             ("min_stability_margin_m", self.min_stability_margin_m),
             ("min_lift_margin_m", self.min_lift_margin_m),
+            ("lift_margin_reserve_m", self.lift_margin_reserve_m),
         ];
         for (name, value) in non_negative {
             if !(value.is_finite() && value >= 0.0) {

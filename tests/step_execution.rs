@@ -262,6 +262,30 @@ fn platform_whole_mission_in_closed_loop() {
 }
 
 #[test]
+fn step_down_whole_mission_in_closed_loop() {
+    // Stepping down from a 0.2 m platform. The generator once accepted the rear-right
+    // step with 3 cm of estimated margin on three legs; the executor, which asks 5 cm
+    // for the support legs' sag, could not shift the base that far over the planted
+    // legs and aborted, and the return to the driving posture rolled the right rear foot
+    // off the platform's edge (CoM 0.31 m outside the support). The generator now asks
+    // the executor's lift threshold of every three-legged posture: no step is aborted.
+    run_whole("step_down");
+}
+
+#[test]
+fn indoor_stairs_whole_mission_in_closed_loop() {
+    // Three 0.17 m rises on 0.29 m treads. The generator counted each foot as one point
+    // under its wheel pair; the base rolls 3–6° to move the CoM over three feet, which
+    // tilts every pair onto its lower wheel, 6 cm aside: a rear step planned with 9 cm of
+    // margin measured 1.6 cm, the guard's rolling corrections narrowed the support
+    // further, three rear steps were aborted, and the returns to the driving posture put
+    // the CoM 0.45 m outside the support. The generator now stands each pair on the
+    // wheels its roll leaves on the ground, and the guard does not roll where that loses
+    // margin: every step is lifted.
+    run_whole("stairs_indoor");
+}
+
+#[test]
 fn staircase_whole_mission_in_closed_loop_pitches_with_the_stairs() {
     let s = run_whole("staircase");
     // Treads 0.12 m high and 0.7 m deep, the feet 0.7 m apart: the front feet stand one
@@ -280,12 +304,14 @@ fn staircase_whole_mission_in_closed_loop_pitches_with_the_stairs() {
 
 #[test]
 fn an_aborted_step_returns_to_the_driving_posture_and_replans() {
-    // A lift threshold no posture can meet (30 cm): the first step is aborted without
-    // lifting, the robot returns to the driving posture where it stands, and the job
-    // replans from there (once). Until the motion generator expands the staircase's rear
-    // steps up (issue 5) the replan's expansion fails; after that, the replanned first
-    // step is aborted again and no replan is left. Either way the run stops, reported.
-    let mut sc = common::scenario("staircase");
+    // A lift threshold no posture can meet (30 cm) for the executor only, after the
+    // plan was made with the paper's: the first step is aborted without lifting, the
+    // robot returns to the driving posture where it stands, and the job replans from
+    // there (once). The planner asks the same threshold of its steps, so the replan finds
+    // no path (or, were one found, its first step would be aborted again with no replan
+    // left). Either way the run stops, reported.
+    let planned = common::scenario("staircase");
+    let mut sc = planned.clone();
     sc.params.min_lift_margin_m = 0.3;
     let opts = RunOptions {
         max_replans: 1,
@@ -295,9 +321,9 @@ fn an_aborted_step_returns_to_the_driving_posture_and_replans() {
     let wall = Instant::now();
     let mut sim = Simulation::new(&sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
-    let plan = plan::run(&sc, &robot, &plan_options()).expect("plan");
+    let plan = plan::run(&planned, &robot, &plan_options()).expect("plan");
     let detailed =
-        run::expand_mission(&sc, &mut sim, &plan, plan.path.len()).expect("the plan expands");
+        run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
     momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
     let s = run::execute(&sc, &mut sim, Mission { plan, detailed }, &opts, wall).expect("runs");
     println!("abort: {:?} / {:?}", s.failure, s.executor_events);

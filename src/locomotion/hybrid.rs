@@ -305,6 +305,7 @@ impl HybridConfig {
             motion: {
                 let mut m = MotionOptions::from_params(params);
                 m.min_margin_m += PLANNER_MARGIN_SLACK_M;
+                m.min_three_contact_margin_m += PLANNER_MARGIN_SLACK_M;
                 m
             },
         }

@@ -34,7 +34,9 @@
 //! foot motion and every 0.02 rad) is solved with the leg IK (reach with
 //! `StandingRule::reach_margin_m` to spare, joint limits) and its CoM computed with the
 //! [`CenterOfMassModel`]; its margin in the support polygon of the feet in contact must be
-//! at least [`MotionOptions::min_margin_m`] (default 3 cm).
+//! at least [`MotionOptions::min_margin_m`] (default 3 cm), and with a foot lifted the
+//! executor's lift threshold, [`MotionOptions::min_three_contact_margin_m`] (5 cm: the
+//! estimate leaves out the support legs' sag toward the unloaded foot).
 //!
 //! **Alternatives before failing**: a step is tried at the leg heights of the shared
 //! standing rule at which it stays within reach (`StandingRule::step_heights`, the same
@@ -76,6 +78,12 @@ use crate::robot::{Leg, RobotDescription};
 pub struct MotionOptions {
     /// Minimum static stability margin at every keyframe and interpolated point, m.
     pub min_margin_m: f64,
+    /// Minimum margin of a posture with three feet in contact, m: the executor's lift
+    /// threshold, `Params::min_lift_margin_m` + `Params::lift_margin_reserve_m` (5 cm),
+    /// where it exceeds `min_margin_m`. The CoM estimate leaves out the sag of the
+    /// compliant support legs toward an unloaded foot; a step whose lifted phase held only
+    /// `min_margin_m` was one the executor's guard refused to lift.
+    pub min_three_contact_margin_m: f64,
     /// With [`StepModel::Stairs`] the partner wheel stops where its leg leaves reach
     /// (a shorter move, the rest to roll and shift); with the paper's model a candidate
     /// whose wheel move leaves reach fails, as before (the shorter move admitted steps
@@ -114,6 +122,7 @@ impl MotionOptions {
     pub fn from_params(params: &Params) -> Self {
         Self {
             min_margin_m: params.min_stability_margin_m,
+            min_three_contact_margin_m: params.min_lift_margin_m + params.lift_margin_reserve_m,
             step_model: params.step_model,
             standing: StandingRule::from_params(params),
             driving_leg_height_m: params.driving_leg_height_m,
@@ -128,6 +137,16 @@ impl MotionOptions {
             wheel_speed: 0.1,
             foot_speed: 0.1,
             angular_speed: 0.2,
+        }
+    }
+
+    /// The least margin posture `p` must hold: [`Self::min_margin_m`], and with three feet
+    /// in contact at least [`Self::min_three_contact_margin_m`].
+    pub fn required_margin(&self, p: &Posture) -> f64 {
+        if p.contact.iter().filter(|&&c| c).count() == 3 {
+            self.min_margin_m.max(self.min_three_contact_margin_m)
+        } else {
+            self.min_margin_m
         }
     }
 }
@@ -352,8 +371,9 @@ impl<'a> Expander<'a> {
         let legs = solve_chains(self.robot, p, o.standing.reach_margin_m)?;
         o.standing.legs_clear(self.robot, self.maps.leg_terrain(), &legs)?;
         let e = evaluate_legs(self.robot, self.model, p, &legs);
-        if e.margin < o.min_margin_m {
-            return Err(Infeasible::Margin { margin_m: e.margin, required_m: o.min_margin_m });
+        let required = o.required_margin(p);
+        if e.margin < required {
+            return Err(Infeasible::Margin { margin_m: e.margin, required_m: required });
         }
         Ok(e)
     }
@@ -744,7 +764,8 @@ impl<'a> Expander<'a> {
         // The same for every candidate (what `step_heights` checked the swing at).
         let swing_z =
             rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot, self.cur.base_rpy[2]);
-        let mut best: (f64, String) = (f64::NEG_INFINITY, "no candidate".to_owned());
+        let mut best: (f64, f64, String) =
+            (f64::NEG_INFINITY, self.o.min_margin_m, "no candidate".to_owned());
         let candidates: Box<dyn Iterator<Item = (f64, f64, f64, Shift)>> = match search {
             StepSearch::Planner => {
                 Box::new(heights.take(PLANNER_STEP_HEIGHTS).flat_map(|h| {
@@ -772,7 +793,7 @@ impl<'a> Expander<'a> {
                 Ok(a) => a,
                 Err(e) => {
                     if best.0 == f64::NEG_INFINITY {
-                        best.1 = e;
+                        best.2 = e;
                     }
                     continue;
                 }
@@ -787,12 +808,12 @@ impl<'a> Expander<'a> {
                     return Ok(());
                 }
                 Err(f) => {
-                    let m = match f.cause {
-                        Infeasible::Margin { margin_m, .. } => margin_m,
-                        _ => f64::NEG_INFINITY,
+                    let (m, r) = match f.cause {
+                        Infeasible::Margin { margin_m, required_m } => (margin_m, required_m),
+                        _ => (f64::NEG_INFINITY, self.o.min_margin_m),
                     };
                     if m > best.0 || best.0 == f64::NEG_INFINITY {
-                        best = (m, f.to_string());
+                        best = (m, r, f.to_string());
                     }
                 }
             }
@@ -802,8 +823,8 @@ impl<'a> Expander<'a> {
             index: self.index,
             leg,
             best_margin_m: best.0,
-            required_m: self.o.min_margin_m,
-            reason: best.1,
+            required_m: best.1,
+            reason: best.2,
         })
     }
 
@@ -1155,4 +1176,27 @@ pub fn expand_path(
         steps,
         keyframes: ex.keys,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_posture_on_three_feet_needs_the_lift_threshold() {
+        // The paper's 3 cm for every posture; on three feet the executor's lift threshold,
+        // 2 cm + 3 cm of sag reserve = 5 cm; a threshold below 3 cm does not lower it.
+        let o = MotionOptions::default();
+        let mut p = Posture {
+            base_position: [0.0, 0.0, 0.5],
+            base_rpy: [0.0; 3],
+            feet: [[0.0; 3]; 4],
+            contact: [true; 4],
+        };
+        assert!((o.required_margin(&p) - 0.03).abs() < 1e-12);
+        p.contact[2] = false;
+        assert!((o.required_margin(&p) - 0.05).abs() < 1e-12);
+        let low = MotionOptions { min_three_contact_margin_m: 0.01, ..o };
+        assert!((low.required_margin(&p) - 0.03).abs() < 1e-12);
+    }
 }

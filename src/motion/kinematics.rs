@@ -272,12 +272,45 @@ pub fn evaluate_legs(
     let leg_heights =
         std::array::from_fn(|i| apply(r, p.base_position, robot.hips[i])[2] - p.feet[i][2]);
     let com = model.com_of_solved(legs);
-    let support: Vec<[f64; 2]> =
-        (0..4).filter(|&i| p.contact[i]).map(|i| [p.feet[i][0], p.feet[i][1]]).collect();
+    let support = wheel_support(robot, r, p);
     let margin = stability_margin(&support, [com[0], com[1]]);
     let centroid_distance =
         support_centroid(&support).map_or(f64::INFINITY, |c| norm2(c[0] - com[0], c[1] - com[1]));
     Evaluation { joints, leg_heights, com, margin, centroid_distance }
+}
+
+/// Height difference between the two wheels of a pair up to which both bear weight, m:
+/// about what the soft wheel contacts give under the robot's weight.
+pub const WHEEL_PAIR_LEVEL_TOLERANCE_M: f64 = 0.002;
+
+/// The ground points of posture `p`'s supporting wheels (base rotation `r`): a foot in
+/// contact stands on its two wheels, half the track either side of its point along the
+/// pair's axle (the base's y' with the wheels steered straight, as they are while
+/// stepping), or, where a rolled base tilts the axle so that one wheel stands more than
+/// [`WHEEL_PAIR_LEVEL_TOLERANCE_M`] above the other, on the lower wheel alone. The legs
+/// only pitch, so a base roll tilts every pair with it: rolled 5° to move the CoM over
+/// three feet, each pair stands on the wheel on the lower side, 6 cm from its foot point,
+/// and the support triangle moves with them (measured in MuJoCo on indoor stairs: a rear
+/// step planned with 9 cm of margin measured 1.6 cm).
+pub fn wheel_support(robot: &RobotDescription, r: &[[f64; 3]; 3], p: &Posture) -> Vec<[f64; 2]> {
+    let half = robot.wheel_track / 2.0;
+    let axle = [r[0][1] * half, r[1][1] * half];
+    // How much higher the left wheel (+y') stands than the right one.
+    let rise = robot.wheel_track * r[2][1];
+    let mut points = Vec::with_capacity(8);
+    for i in (0..4).filter(|&i| p.contact[i]) {
+        let f = p.feet[i];
+        let left = [f[0] + axle[0], f[1] + axle[1]];
+        let right = [f[0] - axle[0], f[1] - axle[1]];
+        if rise.abs() <= WHEEL_PAIR_LEVEL_TOLERANCE_M {
+            points.extend([left, right]);
+        } else if rise > 0.0 {
+            points.push(right);
+        } else {
+            points.push(left);
+        }
+    }
+    points
 }
 
 /// Base pitch for feet `feet` under a base heading `yaw` (Sec. VI-B): `pitch_fraction` of
@@ -361,6 +394,38 @@ pub fn interpolate(a: &Posture, b: &Posture, t: f64) -> Posture {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_level_pair_stands_on_both_wheels_a_rolled_one_on_its_lower_wheel() {
+        // Track 0.12 m: level, each foot in contact gives its two wheels 0.06 m either side
+        // along y' (yaw 0: world y); FR lifted gives none.
+        let robot = RobotDescription::reference();
+        let mut p = Posture {
+            base_position: [0.0, 0.0, 0.5],
+            base_rpy: [0.0; 3],
+            feet: [[0.35, 0.3, 0.0], [0.35, -0.3, 0.0], [-0.35, 0.3, 0.0], [-0.35, -0.3, 0.0]],
+            contact: [true, false, true, true],
+        };
+        let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-12;
+        let level = wheel_support(&robot, &rotation(p.base_rpy), &p);
+        assert_eq!(level.len(), 6);
+        assert!(near(level[0], [0.35, 0.36]) && near(level[1], [0.35, 0.24]), "{level:?}");
+        // Rolled 5° left side up: the left wheel stands 0.12 · sin 5° = 10 mm higher (more
+        // than the 2 mm tolerance), so each pair stands on its right wheel, 0.06 · cos 5°
+        // to the right of its foot.
+        p.base_rpy[0] = 5f64.to_radians();
+        let rolled = wheel_support(&robot, &rotation(p.base_rpy), &p);
+        let d = 0.06 * 5f64.to_radians().cos();
+        assert_eq!(rolled.len(), 3);
+        assert!(near(rolled[0], [0.35, 0.3 - d]) && near(rolled[2], [-0.35, -0.3 - d]));
+        // Turned to yaw 90° and rolled the other way: the left (+y' = world −x) wheel.
+        p.base_rpy = [-5f64.to_radians(), 0.0, std::f64::consts::FRAC_PI_2];
+        let turned = wheel_support(&robot, &rotation(p.base_rpy), &p);
+        assert!(near(turned[0], [0.35 - d, 0.3]), "{turned:?}");
+        // 0.9° of roll lifts a wheel 1.9 mm: both still bear weight.
+        p.base_rpy[0] = 0.9f64.to_radians();
+        assert_eq!(wheel_support(&robot, &rotation(p.base_rpy), &p).len(), 6);
+    }
 
     #[test]
     fn driving_posture_on_a_slope_by_hand() {

@@ -11,8 +11,9 @@ use super::{
     ActiveStep, Command, ExecEventKind, ExecFailure, Mode, Observation, StepExecutor, planar,
 };
 use crate::geometry::{Pose2, wrap_angle};
-use crate::motion::kinematics::Posture;
+use crate::motion::kinematics::{Posture, rotation, wheel_support};
 use crate::robot::Leg;
+use crate::stability::stability_margin;
 
 /// The planar offset (m) to add to a world foothold `foothold` so that, with the robot
 /// displaced from its commanded base `commanded` to the measured `measured`, a foot
@@ -42,6 +43,10 @@ pub fn correction_roll(p: &Posture, correction: [f64; 2]) -> f64 {
     -lat / h
 }
 
+/// The fraction of a base correction the CoM follows: the base and the upper legs move
+/// with it, the feet stay planted.
+const CORRECTION_COM_FRACTION: f64 = 0.8;
+
 /// The smallest correction increment worth making, m: below it the legs' reach has
 /// stopped the base.
 const MIN_CORRECTION_M: f64 = 0.002;
@@ -68,6 +73,22 @@ impl StepExecutor {
             if excess(at(mid)) <= allowed { lo = mid } else { hi = mid }
         }
         at(lo)
+    }
+
+    /// The support margin the correction `to` is predicted to gain over the current one
+    /// with foot `lifting` up: the CoM `com` moves by [`CORRECTION_COM_FRACTION`] of the
+    /// base's move, and the support is the wheels the corrected posture stands on
+    /// ([`wheel_support`]: rolled, each pair on its lower wheel).
+    fn predicted_gain(&self, com: [f64; 3], to: [f64; 2], lifting: Leg) -> f64 {
+        let margin = |c: [f64; 2]| {
+            let mut q = self.with_correction(&self.cmd, c);
+            q.contact[lifting.index()] = false;
+            let support = wheel_support(&self.robot, &rotation(q.base_rpy), &q);
+            let f = CORRECTION_COM_FRACTION;
+            let d = [c[0] - self.correction[0], c[1] - self.correction[1]];
+            stability_margin(&support, [com[0] + f * d[0], com[1] + f * d[1]])
+        };
+        margin(to) - margin(self.correction)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -124,18 +145,33 @@ impl StepExecutor {
         {
             let dir = [cen[0] - obs.com[0], cen[1] - obs.com[1]];
             let n = dir[0].hypot(dir[1]).max(1e-9);
-            let want = (required + 0.01 - m) / 0.8;
-            let mut next =
-                [self.correction[0] + want * dir[0] / n, self.correction[1] + want * dir[1] / n];
-            let len = next[0].hypot(next[1]);
-            if len > c.max_correction_m {
-                next = next.map(|v| v * c.max_correction_m / len);
-            }
+            let want = (required + 0.01 - m) / CORRECTION_COM_FRACTION;
+            let step = [want * dir[0] / n, want * dir[1] / n];
+            // The same increment without its lateral part (no roll): a roll can tilt
+            // the wheel pairs onto their lower wheels and narrow the support it meant to
+            // widen.
+            let (sy, cy) = self.cmd.base_rpy[2].sin_cos();
+            let along = step[0] * cy + step[1] * sy;
             let from = self.correction;
-            let next = self.within_reach(from, next, leg);
-            // Below the smallest increment the legs in contact reach no further: the step
-            // cannot be stabilised and is aborted below.
-            if (next[0] - from[0]).hypot(next[1] - from[1]) >= MIN_CORRECTION_M {
+            let best = [step, [along * cy, along * sy]]
+                .into_iter()
+                .map(|d| {
+                    let mut next = [from[0] + d[0], from[1] + d[1]];
+                    let len = next[0].hypot(next[1]);
+                    if len > c.max_correction_m {
+                        next = next.map(|v| v * c.max_correction_m / len);
+                    }
+                    let next = self.within_reach(from, next, leg);
+                    (self.predicted_gain(obs.com, next, leg), next)
+                })
+                .max_by(|a, b| a.0.total_cmp(&b.0));
+            // Below the smallest increment the legs in contact reach no further, and a
+            // correction predicted to lose margin does not help: the step cannot be
+            // stabilised and is aborted below.
+            if let Some((gain, next)) = best
+                && gain > 0.0
+                && (next[0] - from[0]).hypot(next[1] - from[1]) >= MIN_CORRECTION_M
+            {
                 self.correction = next;
                 self.event(
                     time,
@@ -252,11 +288,16 @@ mod tests {
             })
             .collect();
         // The lift needs 2 + 3 (reserve) cm; each increment aims 1 cm above:
-        // (0.05 + 0.01 − 0.01) / 0.8 = 6.25 cm, three of them.
+        // (0.05 + 0.01 − 0.01) / 0.8 = 6.25 cm toward the centroid, three of them. Its
+        // lateral part would roll the base by about 0.1 rad and stand every wheel pair on
+        // its lower wheel, 6 cm to the side, narrowing the support more than the CoM
+        // gains: the base moves only along its heading (yaw 0: x), by the increment's x.
+        let cen = o.support_centroid(Leg::FrontLeft).expect("three legs");
+        let along = 0.0625 * (cen[0] - com[0]) / (cen[0] - com[0]).hypot(cen[1] - com[1]);
         assert_eq!(corrections.len(), 3, "{:?}", ex.events);
-        assert!((corrections[0] - 0.0625).abs() < 1e-9, "{corrections:?}");
-        assert!((corrections[1] - 0.125).abs() < 1e-9);
-        assert!((corrections[2] - 0.1875).abs() < 1e-9);
+        for (k, c) in corrections.iter().enumerate() {
+            assert!((c - along.abs() * (k + 1) as f64).abs() < 1e-9, "{corrections:?}");
+        }
         assert_eq!(ex.steps_aborted, 1);
         assert!(
             matches!(

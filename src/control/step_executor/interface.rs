@@ -20,9 +20,9 @@ pub struct ExecutorConfig {
     /// m. From `Params::min_lift_margin_m` (2 cm).
     pub min_lift_margin_m: f64,
     /// Margin asked before a lift on top of `min_lift_margin_m`, m: when the foot unloads,
-    /// the compliant support legs let the CoM sag toward it (measured in MuJoCo: 2.5–3 cm
-    /// on the platform's and the staircase's front steps up), so the margin during the step
-    /// stays above the threshold only if it starts this much higher.
+    /// the compliant support legs let the CoM sag toward it, so the margin during the step
+    /// stays above the threshold only if it starts this much higher. From
+    /// `Params::lift_margin_reserve_m` (3 cm), which the motion generator asks too.
     pub lift_margin_reserve_m: f64,
     /// With a foot in the air, a support margin below this puts the foot down, m.
     pub emergency_margin_m: f64,
@@ -90,7 +90,7 @@ impl ExecutorConfig {
     pub fn from_params(params: &Params, follower: FollowerConfig) -> Self {
         Self {
             min_lift_margin_m: params.min_lift_margin_m,
-            lift_margin_reserve_m: 0.03,
+            lift_margin_reserve_m: params.lift_margin_reserve_m,
             emergency_margin_m: params.min_lift_margin_m / 2.0,
             lift_settle_s: 0.3,
             wheel_hold_gain: 5.0,
