@@ -691,13 +691,17 @@ mod hybrid {
 
     /// The hybrid graph with the heuristic before the cost-to-go (issue 15): the
     /// Euclidean-plus-turn part and the step bound (consistent on their own, see the
-    /// `hybrid` module docs). A reference for the optimum.
+    /// `hybrid` module docs). A reference for the optimum. It searches the graph's
+    /// checked edges (`labelled_successors`), without the intermediate nodes of lazy
+    /// step checks: on such a node this heuristic, its pose's, is not consistent (the
+    /// edge into the node has paid the step's least cost already), and A* with it
+    /// returned a path 3 % above the optimum on a random map.
     struct Baseline<'a, 'c>(&'a mut HybridGraph<'c>);
 
     impl SearchGraph for Baseline<'_, '_> {
         type State = LatticeState;
         fn successors(&mut self, s: LatticeState, out: &mut Vec<(LatticeState, Cost)>) {
-            self.0.successors(s, out)
+            out.extend(self.0.labelled_successors(s).into_iter().map(|(t, c, _)| (t, c)));
         }
         fn heuristic(&self, s: LatticeState) -> Cost {
             let p = self.0.heuristic_parts(s);
