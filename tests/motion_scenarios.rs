@@ -150,6 +150,17 @@ fn staircase_whole_path_is_stable() {
 }
 
 #[test]
+fn stairs_descent_whole_path_is_stable() {
+    // Down three 0.17 m steps on 0.29 m treads. The planner checked a wheel pair's move
+    // at its two ends only, and the generator, interpolating one posture between them,
+    // took a rear knee below the legs' clearance on the way (path element 41, a foot
+    // back to neutral: 3.9 cm of 4). The planner now checks every cell of the way, and
+    // the generator stands the base by the shared rule at each.
+    let (_, _, _, d) = whole_path_checked("stairs_descent");
+    assert!(phases(&d).contains(&Phase::WheelMove));
+}
+
+#[test]
 fn platform_whole_path_is_stable_and_failures_name_the_step() {
     let (s, mut sim, p, d) = whole_path_checked("platform");
     // All four feet end on the platform. (The stabilising base shift of Fig. 12b is

@@ -271,6 +271,29 @@ fn leg_tag(k: usize) -> u8 {
     k as u8 + 1
 }
 
+/// A wheel move the lattice offers: the leg whose pair rolls, the footprint after it, its
+/// cost (C_FM times the step-related factor) and length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct FootMove {
+    kind: ManoeuvreKind,
+    leg: Leg,
+    to: FootOffsets,
+    cost: f64,
+    length_m: f64,
+}
+
+impl FootMove {
+    fn manoeuvre(&self) -> Manoeuvre {
+        Manoeuvre {
+            kind: self.kind,
+            leg: Some(self.leg),
+            length_m: self.length_m,
+            cost: self.cost,
+            step: None,
+        }
+    }
+}
+
 /// Margin the planner's step check requires beyond the generator's, m: the
 /// planner's CoM estimate ([`EstimatedCom`]) is MuJoCo's to a micrometre with the wheels
 /// level, but the roll of eqs. 6–8 is iterated to 3 mm of its target with either model,
@@ -892,6 +915,27 @@ impl<'c> HybridGraph<'c> {
         ok
     }
 
+    /// Whether the robot at `s` (offsets `o`) can roll the wheel pair of move `m` its
+    /// whole way: the footprint with that foot at every cell of the way, the last one
+    /// included, can stand ([`Self::target_ok`], memoised): the generator moves the foot
+    /// through the same cells, the base standing by the shared rule at each
+    /// (`expand`'s wheel move). Checking the two ends alone let a knee dip below the
+    /// legs' clearance on the way.
+    fn wheel_move_feasible(&mut self, s: LatticeState, o: &FootOffsets, m: &FootMove) -> bool {
+        // The end first: where it cannot stand, the way needs no look.
+        if !self.target_ok(s, &m.to) {
+            return false;
+        }
+        let k = m.leg.index();
+        let (from, to) = (i32::from(o[k]), i32::from(m.to[k]));
+        let dir = (to - from).signum();
+        let mut via = *o;
+        ((from + dir)..to).chain((to + 1)..from).all(|v| {
+            via[k] = v as i8;
+            self.target_ok(s, &via)
+        })
+    }
+
     /// Interns `o` and returns the state at `(i, j, θ)` with that footprint.
     fn with_footprint(&mut self, t: LatticeState, o: FootOffsets) -> Option<LatticeState> {
         match self.footprints.intern(o) {
@@ -1034,7 +1078,6 @@ impl<'c> HybridGraph<'c> {
         let Some(feet) = self.feet_of(s, &o) else {
             return;
         };
-        let res = self.lattice.resolution;
         let heading = self.heading(s.theta);
 
         // Abstract steps: criteria 1 and 4 here, 2 and 3 in `best_step`.
@@ -1115,8 +1158,9 @@ impl<'c> HybridGraph<'c> {
         // wheels can drive (at least `foot_move_increment_m`): shorter moves would only
         // multiply footprints, and a later base shift uses the whole lead.
         if near[2] || near[3] {
-            for leg in [Leg::FrontLeft, Leg::FrontRight] {
-                self.push_foot_forward(s, &o, &feet, leg);
+            for k in [Leg::FrontLeft.index(), Leg::FrontRight.index()] {
+                let moves = self.foot_forward_moves(s, &o, &feet, k);
+                self.push_first_feasible_move(s, &o, &moves);
             }
         }
 
@@ -1125,24 +1169,52 @@ impl<'c> HybridGraph<'c> {
         // footprints stay reachable, through a chain instead of every subset of feet
         // (2^4 intermediate footprints per pose become 4).
         if !neutral {
-            for leg in Leg::ALL {
-                let k = leg.index();
-                if o[k] == 0 {
-                    continue;
-                }
-                let back = if o[k] > 0 { (-heading.0, -heading.1) } else { heading };
-                let cells = i32::from(o[k]).abs();
-                let Some(avg) = self.drive_line_cost(feet.pos[k], back, cells, bin) else {
-                    continue;
-                };
-                let mut o2 = o;
-                o2[k] = 0;
-                let length = f64::from(cells) * res;
-                if self.push_foot_move(s, o2, leg, ManoeuvreKind::FootNeutral, length, avg) {
-                    break;
-                }
-            }
+            let moves = self.foot_neutral_moves(s, &o, &feet);
+            self.push_first_feasible_move(s, &o, &moves);
         }
+    }
+
+    /// The wheel pairs back to neutral from `s` (offsets `o`, feet `feet`) whose way is
+    /// drivable, in FL, FR, RL, RR order (of which `special_successors` takes the first
+    /// that passes its checks).
+    fn foot_neutral_moves(&self, s: LatticeState, o: &FootOffsets, feet: &Feet) -> Vec<FootMove> {
+        let res = self.lattice.resolution;
+        let heading = self.heading(s.theta);
+        let bin = self.bin(s.theta);
+        let mut moves = Vec::new();
+        for leg in Leg::ALL {
+            let k = leg.index();
+            if o[k] == 0 {
+                continue;
+            }
+            let back = if o[k] > 0 { (-heading.0, -heading.1) } else { heading };
+            let cells = i32::from(o[k]).abs();
+            let Some(avg) = self.drive_line_cost(feet.pos[k], back, cells, bin) else {
+                continue;
+            };
+            let mut to = *o;
+            to[k] = 0;
+            let length_m = f64::from(cells) * res;
+            let cost = self.config.step_cost_factor * foot_move_cost(&self.config, length_m, avg);
+            moves.push(FootMove { kind: ManoeuvreKind::FootNeutral, leg, to, cost, length_m });
+        }
+        moves
+    }
+
+    /// Offers the first of `moves` (from `s`, offsets `o`) whose way the robot can
+    /// stand on ([`Self::wheel_move_feasible`]).
+    fn push_first_feasible_move(&mut self, s: LatticeState, o: &FootOffsets, moves: &[FootMove]) {
+        let Some(m) = moves.iter().find(|m| self.wheel_move_feasible(s, o, m)).copied() else {
+            return;
+        };
+        let Some(t) = self.with_footprint(s, m.to) else {
+            return;
+        };
+        match m.kind {
+            ManoeuvreKind::FootForward => self.stats.foot_forward += 1,
+            _ => self.stats.foot_neutral += 1,
+        }
+        self.special.push((t, edge_cost(m.cost), m.manoeuvre()));
     }
 
     /// A step of leg `k` with cost terms `step`: its edge cost (C_S times the
@@ -1192,37 +1264,16 @@ impl<'c> HybridGraph<'c> {
         Some((t, cost.saturating_sub(charged), m))
     }
 
-    fn push_foot_move(
-        &mut self,
+    /// The "front foot forward" moves of leg index `k` (see `special_successors`), longest
+    /// first: as far as the leg reaches and the wheels can drive, at least
+    /// `foot_move_increment_m`.
+    fn foot_forward_moves(
+        &self,
         s: LatticeState,
-        o2: FootOffsets,
-        leg: Leg,
-        kind: ManoeuvreKind,
-        length: f64,
-        avg: f64,
-    ) -> bool {
-        if !self.target_ok(s, &o2) {
-            return false;
-        }
-        let Some(t) = self.with_footprint(s, o2) else {
-            return false;
-        };
-        let cost = self.config.step_cost_factor * foot_move_cost(&self.config, length, avg);
-        match kind {
-            ManoeuvreKind::FootForward => self.stats.foot_forward += 1,
-            _ => self.stats.foot_neutral += 1,
-        }
-        self.special.push((
-            t,
-            edge_cost(cost),
-            Manoeuvre { kind, leg: Some(leg), length_m: length, cost, step: None },
-        ));
-        true
-    }
-
-    /// The "front foot forward" move of `leg` (see `special_successors`).
-    fn push_foot_forward(&mut self, s: LatticeState, o: &FootOffsets, feet: &Feet, leg: Leg) {
-        let k = leg.index();
+        o: &FootOffsets,
+        feet: &Feet,
+        k: usize,
+    ) -> Vec<FootMove> {
         let res = self.lattice.resolution;
         let (hx, hy) = self.heading(s.theta);
         let bin = self.bin(s.theta);
@@ -1243,17 +1294,19 @@ impl<'c> HybridGraph<'c> {
             }
         }
         let min_d = i32::from(self.foot_move_cells);
-        let mut d = last;
-        while d >= min_d {
-            let mut o2 = *o;
-            o2[k] = (i32::from(o[k]) + d) as i8;
-            let avg = sums[d as usize] / f64::from(d + 1);
-            let length = f64::from(d) * res;
-            if self.push_foot_move(s, o2, leg, ManoeuvreKind::FootForward, length, avg) {
-                return;
-            }
-            d -= 1;
-        }
+        let leg = Leg::ALL[k];
+        (min_d..=last)
+            .rev()
+            .map(|d| {
+                let mut to = *o;
+                to[k] = (i32::from(o[k]) + d) as i8;
+                let avg = sums[d as usize] / f64::from(d + 1);
+                let length_m = f64::from(d) * res;
+                let cost =
+                    self.config.step_cost_factor * foot_move_cost(&self.config, length_m, avg);
+                FootMove { kind: ManoeuvreKind::FootForward, leg, to, cost, length_m }
+            })
+            .collect()
     }
 
     /// The support pre-check of a step of `leg` from state `s` (feet `feet`) to `post`

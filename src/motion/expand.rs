@@ -844,22 +844,35 @@ impl<'a> Expander<'a> {
     }
 
     /// The wheel move of one foot to `foot` (x, y on the ground), the base standing by the
-    /// shared rule at its current place.
+    /// shared rule at its current place: through every cell of the way (a keyframe per
+    /// height-map cell the foot rolls over), the base re-stood by the rule at each, as the
+    /// planner checked the move (`locomotion::hybrid`: every footprint of the way can
+    /// stand). A single keyframe at the end let the interpolation between the two ends
+    /// dip a knee below the legs' clearance that both ends kept.
     fn expand_wheel_move(
         &mut self,
         kind: PathKind,
         leg: Leg,
         foot: [f64; 2],
     ) -> Result<(), MotionError> {
-        let mut feet = self.cur.feet;
-        feet[leg.index()] = [foot[0], foot[1], self.ground(foot[0], foot[1])?];
+        let i = leg.index();
+        let from = self.cur.feet[i];
+        let (dx, dy) = (foot[0] - from[0], foot[1] - from[1]);
+        let res = self.maps.heights().resolution();
+        let n = ((dx.hypot(dy) / res).round() as usize).max(1);
         let (xy, yaw) = (self.xy(), self.cur.base_rpy[2]);
-        let p = self.standing_fallback(feet, xy, yaw).map_err(|reason| MotionError::Manoeuvre {
-            index: self.index,
-            kind: kind_name(kind),
-            reason,
-        })?;
-        self.push(kind, &[(Phase::WheelMove, Some(leg), p)])
+        let mut feet = self.cur.feet;
+        let mut seq = Vec::with_capacity(n);
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            let (x, y) = (from[0] + dx * t, from[1] + dy * t);
+            feet[i] = [x, y, self.ground(x, y)?];
+            let p = self.standing_fallback(feet, xy, yaw).map_err(|reason| {
+                MotionError::Manoeuvre { index: self.index, kind: kind_name(kind), reason }
+            })?;
+            seq.push((Phase::WheelMove, Some(leg), p));
+        }
+        self.push(kind, &seq)
     }
 }
 
