@@ -2,8 +2,10 @@
 //! MuJoCo must reach the lift threshold plus reserve (more per retry); if it does not, the
 //! base is moved toward the support centroid in bounded increments (a base shift
 //! longitudinally, a roll about the ground laterally: [`correction_roll`]) as far as the
-//! planted legs reach (`StepExecutor::within_reach`), else the step is aborted. At the
-//! lift the landing offset ([`landing_offset`]) of the swing foot is frozen.
+//! planted legs reach (`StepExecutor::within_reach`), without the roll where the wheels
+//! it tilts the pairs onto are predicted to lose margin (`StepExecutor::predicted_gain`),
+//! else the step is aborted. At the lift the landing offset ([`landing_offset`]) of the
+//! swing foot is frozen.
 
 use super::actuation::{REACH_SPARE_M, reach_excess};
 use super::timing::smoothstep;

@@ -29,8 +29,9 @@
 //!   ([`ExecutorConfig::lift_margin_reserve_m`]). If it does not, the base is moved toward
 //!   the support triangle's centroid in bounded increments: longitudinally by a base shift,
 //!   laterally by a roll about the ground ([`correction_roll`]; the legs move only in their
-//!   sagittal planes). If that does not suffice, the step is aborted (the foot is not
-//!   lifted).
+//!   sagittal planes), the roll left out where it is predicted to lose margin (a rolled
+//!   base tilts each wheel pair onto its lower wheel, `motion::kinematics::wheel_support`).
+//!   If that does not suffice, the step is aborted (the foot is not lifted).
 //! - **While a foot is in the air** the support margin is watched; below
 //!   [`ExecutorConfig::emergency_margin_m`] the foot is put down where it is (lowered until
 //!   MuJoCo reports contact), and the step is retried from the lift (bounded).
