@@ -928,9 +928,9 @@ impl<'c> HybridGraph<'c> {
         }
         let k = m.leg.index();
         let (from, to) = (i32::from(o[k]), i32::from(m.to[k]));
-        let dir = (to - from).signum();
         let mut via = *o;
-        ((from + dir)..to).chain((to + 1)..from).all(|v| {
+        // The offsets strictly between the two ends.
+        (from.min(to) + 1..from.max(to)).all(|v| {
             via[k] = v as i8;
             self.target_ok(s, &via)
         })
@@ -1174,6 +1174,21 @@ impl<'c> HybridGraph<'c> {
         }
     }
 
+    /// The wheel move of `kind` of `leg`'s pair to footprint `to`, `length_m` long over
+    /// cells of mean foot cost `avg`, at its cost C_FM (eq. 6) times the step-related
+    /// factor.
+    fn foot_move(
+        &self,
+        kind: ManoeuvreKind,
+        leg: Leg,
+        to: FootOffsets,
+        length_m: f64,
+        avg: f64,
+    ) -> FootMove {
+        let cost = self.config.step_cost_factor * foot_move_cost(&self.config, length_m, avg);
+        FootMove { kind, leg, to, cost, length_m }
+    }
+
     /// The wheel pairs back to neutral from `s` (offsets `o`, feet `feet`) whose way is
     /// drivable, in FL, FR, RL, RR order (of which `special_successors` takes the first
     /// that passes its checks).
@@ -1195,8 +1210,7 @@ impl<'c> HybridGraph<'c> {
             let mut to = *o;
             to[k] = 0;
             let length_m = f64::from(cells) * res;
-            let cost = self.config.step_cost_factor * foot_move_cost(&self.config, length_m, avg);
-            moves.push(FootMove { kind: ManoeuvreKind::FootNeutral, leg, to, cost, length_m });
+            moves.push(self.foot_move(ManoeuvreKind::FootNeutral, leg, to, length_m, avg));
         }
         moves
     }
@@ -1302,9 +1316,7 @@ impl<'c> HybridGraph<'c> {
                 to[k] = (i32::from(o[k]) + d) as i8;
                 let avg = sums[d as usize] / f64::from(d + 1);
                 let length_m = f64::from(d) * res;
-                let cost =
-                    self.config.step_cost_factor * foot_move_cost(&self.config, length_m, avg);
-                FootMove { kind: ManoeuvreKind::FootForward, leg, to, cost, length_m }
+                self.foot_move(ManoeuvreKind::FootForward, leg, to, length_m, avg)
             })
             .collect()
     }

@@ -3,7 +3,7 @@
 //! base is moved toward the support centroid in bounded increments (a base shift
 //! longitudinally, a roll about the ground laterally: [`correction_roll`]) as far as the
 //! planted legs reach (`StepExecutor::within_reach`), without the roll where the wheels
-//! it tilts the pairs onto are predicted to lose margin (`StepExecutor::predicted_gain`),
+//! it tilts the pairs onto are predicted to lose margin (`StepExecutor::predicted_margin`),
 //! else the step is aborted. At the lift the landing offset ([`landing_offset`]) of the
 //! swing foot is frozen.
 
@@ -77,20 +77,18 @@ impl StepExecutor {
         at(lo)
     }
 
-    /// The support margin the correction `to` is predicted to gain over the current one
-    /// with foot `lifting` up: the CoM `com` moves by [`CORRECTION_COM_FRACTION`] of the
-    /// base's move, and the support is the wheels the corrected posture stands on
-    /// ([`wheel_support`]: rolled, each pair on its lower wheel).
-    fn predicted_gain(&self, com: [f64; 3], to: [f64; 2], lifting: Leg) -> f64 {
-        let margin = |c: [f64; 2]| {
-            let mut q = self.with_correction(&self.cmd, c);
-            q.contact[lifting.index()] = false;
-            let support = wheel_support(&self.robot, &rotation(q.base_rpy), &q);
-            let f = CORRECTION_COM_FRACTION;
-            let d = [c[0] - self.correction[0], c[1] - self.correction[1]];
-            stability_margin(&support, [com[0] + f * d[0], com[1] + f * d[1]])
-        };
-        margin(to) - margin(self.correction)
+    /// The support margin predicted with the correction `c` and foot `lifting` up: the
+    /// measured CoM `com` moves by [`CORRECTION_COM_FRACTION`] of the base's move from the
+    /// current correction, and the support is the wheels the corrected posture stands on
+    /// ([`wheel_support`]: rolled, each pair on its lower wheel). Compared with the
+    /// current correction's prediction, it gives what a correction gains.
+    fn predicted_margin(&self, com: [f64; 3], c: [f64; 2], lifting: Leg) -> f64 {
+        let mut q = self.with_correction(&self.cmd, c);
+        q.contact[lifting.index()] = false;
+        let support = wheel_support(&self.robot, &rotation(q.base_rpy), &q);
+        let f = CORRECTION_COM_FRACTION;
+        let d = [c[0] - self.correction[0], c[1] - self.correction[1]];
+        stability_margin(&support, [com[0] + f * d[0], com[1] + f * d[1]])
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -155,6 +153,7 @@ impl StepExecutor {
             let (sy, cy) = self.cmd.base_rpy[2].sin_cos();
             let along = step[0] * cy + step[1] * sy;
             let from = self.correction;
+            let now = self.predicted_margin(obs.com, from, leg);
             let best = [step, [along * cy, along * sy]]
                 .into_iter()
                 .map(|d| {
@@ -164,7 +163,7 @@ impl StepExecutor {
                         next = next.map(|v| v * c.max_correction_m / len);
                     }
                     let next = self.within_reach(from, next, leg);
-                    (self.predicted_gain(obs.com, next, leg), next)
+                    (self.predicted_margin(obs.com, next, leg) - now, next)
                 })
                 .max_by(|a, b| a.0.total_cmp(&b.0));
             // Below the smallest increment the legs in contact reach no further, and a
