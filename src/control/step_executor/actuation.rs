@@ -68,12 +68,12 @@ pub fn reachable_leg_targets(
 /// How far the furthest-reaching leg in contact of posture `p`, `except` left out, asks
 /// beyond its reach (thigh plus shin, less `spare`), m; zero or less when every such foot
 /// is reached. [`reachable_leg_targets`] would pull such a foot in, off the ground.
-pub fn reach_excess(robot: &RobotDescription, p: &Posture, spare: f64, except: Leg) -> f64 {
+pub fn reach_excess(robot: &RobotDescription, p: &Posture, spare: f64, except: Option<Leg>) -> f64 {
     let local = contacts_in_base(robot, p);
     let reach = robot.thigh_length + robot.shin_length - spare;
     Leg::ALL
         .into_iter()
-        .filter(|&leg| p.contact[leg.index()] && leg != except)
+        .filter(|&leg| p.contact[leg.index()] && Some(leg) != except)
         .map(|leg| {
             let c = local[leg.index()];
             let ankle = ankle_of_contact(robot, [c[0], c[2]], p.base_rpy[1]);
@@ -82,13 +82,43 @@ pub fn reach_excess(robot: &RobotDescription, p: &Posture, spare: f64, except: L
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
+/// The largest fraction `a` in [0, 1] of a move at which `excess(a)`, the reach excess
+/// ([`reach_excess`]) of the posture that far along the move, stays within `allowed`: 1 if
+/// the whole move does, else found by bisection. `excess(0) <= allowed` is assumed, so the
+/// answer is always within reach even where the excess is not monotonic along the move.
+pub(super) fn reachable_fraction(excess: impl Fn(f64) -> f64, allowed: f64) -> f64 {
+    if excess(1.0) <= allowed {
+        return 1.0;
+    }
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..20 {
+        let mid = 0.5 * (lo + hi);
+        if excess(mid) <= allowed { lo = mid } else { hi = mid }
+    }
+    lo
+}
+
+/// `p` with its base moved by `hold` in the plane.
+pub(super) fn held_by(p: &Posture, hold: [f64; 2]) -> Posture {
+    let mut q = *p;
+    q.base_position[0] += hold[0];
+    q.base_position[1] += hold[1];
+    q
+}
+
 fn straight(speed: f64) -> WheelPairCommand {
     WheelPairCommand { steer: 0.0, wheel_speeds: [speed, speed] }
 }
 
 impl StepExecutor {
+    /// `p` with the base moved by the position hold (`ExecutorConfig::max_base_hold_m`):
+    /// the posture the legs are solved for, so the compliant robot stands at `p`.
+    pub(super) fn held(&self, p: &Posture) -> Posture {
+        held_by(p, self.base_hold)
+    }
+
     pub(super) fn legs_for(&mut self, p: &Posture, time: f64) -> Option<[[f64; 3]; 4]> {
-        match reachable_leg_targets(&self.robot, p, REACH_SPARE_M) {
+        match reachable_leg_targets(&self.robot, &self.held(p), REACH_SPARE_M) {
             Ok(q) => {
                 self.last_legs = q;
                 Some(q)
@@ -103,7 +133,7 @@ impl StepExecutor {
     /// Joint targets for `p`, or the last ones if `p` cannot be solved (while already
     /// recovering, a failure must not start another recovery).
     pub(super) fn legs_or_hold(&mut self, p: &Posture) -> [[f64; 3]; 4] {
-        if let Ok(q) = reachable_leg_targets(&self.robot, p, REACH_SPARE_M) {
+        if let Ok(q) = reachable_leg_targets(&self.robot, &self.held(p), REACH_SPARE_M) {
             self.last_legs = q;
         }
         self.last_legs

@@ -136,10 +136,14 @@ impl StepExecutor {
 
 #[cfg(test)]
 mod tests {
+    use crate::control::step_executor::actuation::{REACH_SPARE_M, reach_excess};
     use crate::control::step_executor::test_support::{
         all_contacts, config, ground, obs, robot, step_path,
     };
-    use crate::control::step_executor::{ExecEventKind, ExecFailure, ExecStatus, StepExecutor};
+    use crate::control::step_executor::{
+        ExecEventKind, ExecFailure, ExecStatus, ExecutorConfig, Mode, StepExecutor,
+    };
+    use crate::geometry::Pose2;
     use crate::motion::Phase;
     use crate::robot::Leg;
 
@@ -223,5 +227,48 @@ mod tests {
         assert_eq!(run(None, 10).0, 0.0);
         // A base standing higher than commanded is not lowered.
         assert_eq!(run(Some(0.52), 10).0, 0.0);
+    }
+
+    #[test]
+    fn the_base_position_hold_integrates_the_lag_along_the_heading_within_reach() {
+        // The keyframes stand the base at the origin facing +x; MuJoCo measures it `at`.
+        // Returns the hold along x and y after `ticks` ticks of 10 ms.
+        let keys = step_path();
+        let com = [-0.1, -0.1, 0.4];
+        let contacts = all_contacts(&keys[0].feet);
+        let run = |config: ExecutorConfig, at: [f64; 2], ticks: usize| {
+            let mut ex = StepExecutor::new(&robot(), config, keys.clone(), ground());
+            for k in 0..ticks {
+                let mut o = obs(0.01 * (k + 1) as f64, &ex, &contacts, com);
+                o.base = Pose2::new(at[0], at[1], 0.0);
+                ex.tick(&o, 0.01);
+            }
+            ex
+        };
+        // 2 cm behind: with the gain 2/s the legs are solved for a base 2 · 0.02 · 0.1 =
+        // 4 mm ahead after 0.1 s.
+        let ex = run(config(), [-0.02, 0.0], 10);
+        assert!((ex.base_hold[0] - 0.004).abs() < 1e-9, "{:?}", ex.base_hold);
+        assert!(ex.base_hold[1].abs() < 1e-12);
+        let solved = ex.held(&ex.cmd);
+        assert!((solved.base_position[0] - ex.cmd.base_position[0] - 0.004).abs() < 1e-9);
+        // 10 cm behind for 0.3 s asks 6 cm: the cap, 4 cm.
+        let ex = run(config(), [-0.1, 0.0], 30);
+        assert!((ex.base_hold[0] - config().max_base_hold_m).abs() < 1e-12);
+        // Sideways the sagittal legs cannot carry the base: no hold.
+        assert_eq!(run(config(), [0.0, 0.05], 30).base_hold, [0.0, 0.0]);
+        // Never past reach: with a high gain and no cap, the hold stops where the legs
+        // (hips 0.45 m up, ankles 0.18 m above the ground, so 0.27 m below the hips) reach
+        // 0.5 m less the executor's 1 mm spare: √(0.499² − 0.27²) = 0.419644 m.
+        let wide = ExecutorConfig { base_hold_gain: 100.0, max_base_hold_m: 1.0, ..config() };
+        let ex = run(wide, [-0.1, 0.0], 20);
+        assert!((ex.base_hold[0] - 0.419644).abs() < 1e-4, "{:?}", ex.base_hold);
+        let solved = ex.held(&ex.cmd);
+        assert!(reach_excess(&ex.robot, &solved, REACH_SPARE_M, None) <= 1e-12);
+        // Driving (or any mode but the standing ones) drops it.
+        let mut ex = run(config(), [-0.02, 0.0], 10);
+        ex.mode = Mode::Finished;
+        ex.tick(&obs(0.2, &ex, &contacts, com), 0.01);
+        assert_eq!(ex.base_hold, [0.0, 0.0]);
     }
 }

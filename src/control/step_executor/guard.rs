@@ -7,7 +7,7 @@
 //! else the step is aborted. At the lift the landing offset ([`landing_offset`]) of the
 //! swing foot is frozen.
 
-use super::actuation::{REACH_SPARE_M, reach_excess};
+use super::actuation::{REACH_SPARE_M, reach_excess, reachable_fraction};
 use super::timing::smoothstep;
 use super::{
     ActiveStep, Command, ExecEventKind, ExecFailure, Mode, Observation, StepExecutor, planar,
@@ -62,19 +62,17 @@ impl StepExecutor {
     /// down: a rear wheel lifted, the margin fell from 2.6 cm to −24.5 cm).
     fn within_reach(&self, from: [f64; 2], to: [f64; 2], lifting: Leg) -> [f64; 2] {
         let excess = |c: [f64; 2]| {
-            reach_excess(&self.robot, &self.with_correction(&self.cmd, c), REACH_SPARE_M, lifting)
+            reach_excess(
+                &self.robot,
+                &self.with_correction(&self.cmd, c),
+                REACH_SPARE_M,
+                Some(lifting),
+            )
         };
         let allowed = excess(from).max(0.0);
-        if excess(to) <= allowed {
-            return to;
-        }
         let at = |a: f64| [from[0] + a * (to[0] - from[0]), from[1] + a * (to[1] - from[1])];
-        let (mut lo, mut hi) = (0.0, 1.0);
-        for _ in 0..20 {
-            let mid = 0.5 * (lo + hi);
-            if excess(at(mid)) <= allowed { lo = mid } else { hi = mid }
-        }
-        at(lo)
+        let a = reachable_fraction(|a| excess(at(a)), allowed);
+        if a >= 1.0 { to } else { at(a) }
     }
 
     /// The support margin predicted with the correction `c` and foot `lifting` up: the
@@ -226,7 +224,12 @@ mod tests {
         let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
         ex.cmd = standing();
         let excess = |ex: &StepExecutor, c: [f64; 2]| {
-            reach_excess(&ex.robot, &ex.with_correction(&ex.cmd, c), REACH_SPARE_M, Leg::FrontLeft)
+            reach_excess(
+                &ex.robot,
+                &ex.with_correction(&ex.cmd, c),
+                REACH_SPARE_M,
+                Some(Leg::FrontLeft),
+            )
         };
         assert!(excess(&ex, [0.0, 0.0]) < 0.0);
         assert!(excess(&ex, [0.6, 0.0]) > 0.0);

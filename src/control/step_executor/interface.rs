@@ -41,6 +41,15 @@ pub struct ExecutorConfig {
     pub base_hold_gain: f64,
     /// Largest base raise of the height hold, m.
     pub max_base_lift_m: f64,
+    /// Largest planar offset of the base position hold, m. The same compliance that sinks
+    /// the base lets it lag a standing manoeuvre, and stance wheels creep under the legs'
+    /// push: after a base shift the base stood 4 cm beyond its keyframes and a rear
+    /// thigh touched a stair nosing the plan cleared. During standing manoeuvres the
+    /// executor offsets the base it solves the legs for, along its heading (the legs move
+    /// in their sagittal planes), by the integral of the measured error along it,
+    /// `hold += base_hold_gain · (reference − measured) · heading · dt`, the reference
+    /// being the keyframes' base with the stabilising correction, clamped to this length.
+    pub max_base_hold_m: f64,
     /// Largest stabilising base correction toward the support centroid, m.
     pub max_correction_m: f64,
     /// Time over which a correction increment is applied, s.
@@ -96,6 +105,7 @@ impl ExecutorConfig {
             wheel_hold_gain: 5.0,
             base_hold_gain: 2.0,
             max_base_lift_m: 0.04,
+            max_base_hold_m: 0.04,
             max_correction_m: 0.06,
             correction_time_s: 0.8,
             max_correction_attempts: 3,

@@ -23,6 +23,14 @@
 //!   commanded base is raised by the integral of the measured shortfall
 //!   ([`ExecutorConfig::base_hold_gain`], capped at [`ExecutorConfig::max_base_lift_m`]);
 //!   driving drops the raise.
+//! - **Base position** in the same modes: the compliance also lets the base lag a standing
+//!   manoeuvre and the stance wheels creep under the legs' push (after a base shift on a
+//!   stair descent the base stood 4 cm beyond its keyframes and a rear thigh touched a
+//!   nosing). The legs are solved for a base offset along its heading by the integral of
+//!   the measured error along it (the sagittal legs cannot carry it sideways; the guard's
+//!   roll does that), capped at [`ExecutorConfig::max_base_hold_m`] and scaled back every
+//!   tick to what the legs in contact reach, so it never winds up into a foot pulled off
+//!   the ground.
 //! - **Before a lift** the support margin measured from MuJoCo (CoM over the wheel
 //!   contacts of the three support legs) must reach [`ExecutorConfig::min_lift_margin_m`]
 //!   (2 cm) plus a reserve for the sag of the compliant support legs when the foot unloads
@@ -83,6 +91,7 @@ use crate::motion::kinematics::Posture;
 use crate::motion::{Keyframe, Phase};
 use crate::robot::{Leg, RobotDescription};
 use crate::terrain::HeightMap;
+use actuation::{REACH_SPARE_M, held_by, reach_excess, reachable_fraction};
 
 fn planar(p: &Posture) -> Pose2 {
     Pose2::new(p.base_position[0], p.base_position[1], p.base_rpy[2])
@@ -141,6 +150,9 @@ pub struct StepExecutor {
     /// The base height hold's raise of the commanded base, m
     /// (`ExecutorConfig::base_hold_gain`).
     base_lift: f64,
+    /// The base position hold's planar offset of the base the legs are solved for, m
+    /// (`ExecutorConfig::max_base_hold_m`).
+    base_hold: [f64; 2],
     last_legs: [[f64; 3]; 4],
     /// Wheel angles the stance wheels hold (None: not holding), rad.
     wheel_hold: [Option<[f64; 2]>; 4],
@@ -189,6 +201,7 @@ impl StepExecutor {
             lift_offset: [0.0; 3],
             landing: [0.0; 2],
             base_lift: 0.0,
+            base_hold: [0.0; 2],
             last_legs,
             wheel_hold: [None; 4],
             now: 0.0,
@@ -290,7 +303,7 @@ impl StepExecutor {
 
     /// One control tick of `dt` s.
     pub fn tick(&mut self, obs: &Observation, dt: f64) -> (Command, ExecStatus) {
-        self.hold_base_height(obs, dt);
+        self.hold_base(obs, dt);
         let cmd = self.step_mode(obs, dt);
         let status = match &self.mode {
             Mode::Finished => ExecStatus::Finished,
@@ -300,24 +313,48 @@ impl StepExecutor {
         (cmd, status)
     }
 
-    /// The base height hold (`ExecutorConfig::base_hold_gain`): in the standing modes
-    /// that command postures through [`Self::with_offsets`], integrates how far the
-    /// measured base stands below the commanded one; elsewhere (driving, the return to
-    /// the driving posture, finished) the raise is dropped.
-    fn hold_base_height(&mut self, obs: &Observation, dt: f64) {
+    /// The base height and position holds (`ExecutorConfig::base_hold_gain`,
+    /// `ExecutorConfig::max_base_hold_m`): in the standing modes that command postures
+    /// through [`Self::with_offsets`], integrate how far the measured base stands below
+    /// the commanded one, and how far it stands from it in the plane; elsewhere (driving,
+    /// the return to the driving posture, finished) both are dropped.
+    fn hold_base(&mut self, obs: &Observation, dt: f64) {
         let standing = matches!(
             self.mode,
             Mode::Segment { .. } | Mode::Guard { .. } | Mode::Confirm { .. } | Mode::PutDown { .. }
         );
-        match obs.base_z {
-            Some(z) if standing => {
-                let shortfall = self.cmd.base_position[2] - z;
-                let c = &self.config;
-                self.base_lift = (self.base_lift + c.base_hold_gain * shortfall * dt)
-                    .clamp(0.0, c.max_base_lift_m);
-            }
-            _ => self.base_lift = 0.0,
+        if !standing {
+            self.base_lift = 0.0;
+            self.base_hold = [0.0; 2];
+            return;
         }
+        let c = &self.config;
+        if let Some(z) = obs.base_z {
+            let shortfall = self.cmd.base_position[2] - z;
+            self.base_lift =
+                (self.base_lift + c.base_hold_gain * shortfall * dt).clamp(0.0, c.max_base_lift_m);
+        } else {
+            self.base_lift = 0.0;
+        }
+        // Along the heading only: the legs move in their sagittal planes and cannot carry
+        // the base sideways (the guard's roll does that).
+        let reference = self.with_offsets(&self.cmd).base_position;
+        let (sy, cy) = self.cmd.base_rpy[2].sin_cos();
+        let along = (reference[0] - obs.base.x) * cy + (reference[1] - obs.base.y) * sy;
+        let held =
+            (self.base_hold[0] * cy + self.base_hold[1] * sy + c.base_hold_gain * along * dt)
+                .clamp(-c.max_base_hold_m, c.max_base_hold_m);
+        // Never past the legs' reach: a hold that stretches a leg in contact beyond its
+        // reach (or further beyond than the posture itself does) would pull that foot off
+        // the ground (`reachable_leg_targets`). The hold is scaled back to what the legs
+        // reach, every tick, as the posture moves on; the integral does not wind up.
+        let p = self.with_offsets(&self.cmd);
+        let excess = |a: f64| {
+            let h = a * held;
+            reach_excess(&self.robot, &held_by(&p, [h * cy, h * sy]), REACH_SPARE_M, None)
+        };
+        let held = held * reachable_fraction(excess, excess(0.0).max(0.0));
+        self.base_hold = [held * cy, held * sy];
     }
 
     fn step_mode(&mut self, obs: &Observation, dt: f64) -> Command {
