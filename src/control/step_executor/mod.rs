@@ -338,7 +338,8 @@ impl StepExecutor {
         }
         // Along the heading only: the legs move in their sagittal planes and cannot carry
         // the base sideways (the guard's roll does that).
-        let reference = self.with_offsets(&self.cmd).base_position;
+        let p = self.with_offsets(&self.cmd);
+        let reference = p.base_position;
         let (sy, cy) = self.cmd.base_rpy[2].sin_cos();
         let along = (reference[0] - obs.base.x) * cy + (reference[1] - obs.base.y) * sy;
         let held =
@@ -348,7 +349,6 @@ impl StepExecutor {
         // reach (or further beyond than the posture itself does) would pull that foot off
         // the ground (`reachable_leg_targets`). The hold is scaled back to what the legs
         // reach, every tick, as the posture moves on; the integral does not wind up.
-        let p = self.with_offsets(&self.cmd);
         let excess = |a: f64| {
             let h = a * held;
             reach_excess(&self.robot, &held_by(&p, [h * cy, h * sy]), REACH_SPARE_M, None)
