@@ -216,10 +216,12 @@ pub enum StepModel {
     Paper,
     /// Adds the rear-step approach (a base shift past the front feet's neutral, where
     /// their way ahead is blocked, so a rear foot reaches a riser while the front feet
-    /// stand on a short tread) and pre-checks a step's support at the generator's lift
-    /// keyframe with its alignments (`locomotion::hybrid`), instead of the tuned margin.
-    /// Climbs and descends building-code stairs; plans the paper's staircase about 6×
-    /// slower, as more steps are feasible.
+    /// stand on a short tread), the climb shift (on a flight longer than the robot, the
+    /// base forward past the front feet's neutral so a rear foot can step and the front
+    /// legs reach the next tread), and pre-checks a step's support at the generator's
+    /// lift keyframe with its alignments (`locomotion::hybrid`), instead of the tuned
+    /// margin. Climbs and descends building-code stairs; plans the paper's staircase
+    /// about 6× slower, as more steps are feasible.
     Stairs,
 }
 

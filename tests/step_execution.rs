@@ -286,6 +286,23 @@ fn indoor_stairs_whole_mission_in_closed_loop() {
 }
 
 #[test]
+fn steep_stairs_whole_mission_in_closed_loop() {
+    // Three 0.20 m rises on 0.25 m treads, the steepest pair of issue 14's range.
+    run_whole("stairs_steep");
+}
+
+#[test]
+fn stairwell_whole_mission_in_closed_loop() {
+    // Four 0.17 m rises on 0.29 m treads between walls: a flight longer than the robot's
+    // feet span. The planner searched every reachable pose without a path: with the
+    // front feet on a tread at or behind neutral and a rear foot short of the first
+    // riser, no manoeuvre brought that foot up to the riser or the base forward. The
+    // partial foot to neutral and the climb shift (`locomotion::hybrid`) do.
+    let s = run_whole("stairs_stairwell");
+    assert_eq!(s.steps_planned, 16);
+}
+
+#[test]
 fn stairs_descent_whole_mission_in_closed_loop() {
     // The indoor stairs, down. The compliant legs let the base lag its keyframes and the
     // stance wheels creep under the legs' push: after the base shift that follows the

@@ -25,7 +25,11 @@
 //!   wheel pair drives forward (keeping ground contact), preparing a rear step — as far
 //!   as its leg reaches and the terrain is drivable, in one move. Cost C_FM (eq. 6).
 //! - **foot to neutral** (Fig. 6d): in a non-neutral footprint, one wheel pair drives
-//!   back to its neutral position. Cost C_FM (eq. 6).
+//!   back to its neutral position. Cost C_FM (eq. 6). With `step_model = "stairs"`,
+//!   where the way to neutral is not drivable and the foot is not close to an obstacle,
+//!   it drives up to the last drivable cell before the obstacle instead (then it is
+//!   close to it, and may step). (With the paper's model it would also apply, but it
+//!   slowed generated `up_and_over` searches by a fifth for no new path.)
 //!
 //! All four manoeuvre costs are multiplied by the step-related factor
 //! ([`HybridConfig::step_cost_factor`], Sec. V, Fig. 7: the calibration is documented on
@@ -75,6 +79,21 @@
 //!   (0.7 m) apart, and on treads shorter than that no footprint puts a rear foot at a
 //!   riser while the front feet stand on a tread. It is a base shift like the others
 //!   (same cost, same heuristic terms), so the heuristic stays consistent.
+//! - *The climb shift* (`step_model = "stairs"` only): a climb is under way (a front
+//!   foot stands higher than a rear foot), a rear foot is close to an obstacle and the
+//!   front feet do not both stand ahead of neutral. On a flight longer than the robot
+//!   the front feet stand on a tread they cannot roll along, at or behind neutral; no
+//!   longitudinal shift applies, a rear foot lifted there leaves the CoM behind the
+//!   other three, and the front legs cannot reach the next tread from so far back. The
+//!   base shifts forward past the front feet's neutral as far as every leg reaches,
+//!   shortened to where a rear foot close to an obstacle can still step (as the
+//!   longitudinal shift is); a base shift like the others. Not offered on descents,
+//!   where it stretched the lower front legs to their reach limit (a planned descent
+//!   with it tipped over in closed loop).
+//! - *Flights longer than the robot* (four or more building-code steps) need the last
+//!   two and the partial foot to neutral: without them a rear foot short of a riser
+//!   could neither step nor roll up to it, and every reachable pose was searched
+//!   without a path.
 //! - *Base shifts* end on the lattice cell containing the exact shifted position (the
 //!   feet then stand up to half a cell from where they were; the paper's grid has the
 //!   same issue). The edge cost is `max(C_BS · factor, distance moved)`, which keeps the
@@ -1038,6 +1057,28 @@ impl<'c> HybridGraph<'c> {
         candidates
     }
 
+    /// The longest drive of a wheel pair from `p` in direction `dir`, at most `cells`
+    /// cells, over drivable cells only: its length in cells and mean foot cost (both
+    /// ends included); `None` if the cell under `p` is not drivable.
+    fn drivable_prefix(
+        &self,
+        p: [f64; 2],
+        dir: (f64, f64),
+        cells: i32,
+        bin: HeadingBin,
+    ) -> Option<(i32, f64)> {
+        let res = self.lattice.resolution;
+        let mut sum = 0.0;
+        let mut last = -1;
+        for k in 0..=cells {
+            let l = f64::from(k) * res;
+            let Ok((c, _)) = self.cell(p[0] + dir.0 * l, p[1] + dir.1 * l, bin) else { break };
+            sum += c;
+            last = k;
+        }
+        (last >= 0).then(|| (last, sum / f64::from(last + 1)))
+    }
+
     /// Mean foot cost along a wheel pair's straight drive of `cells` cells from `p` in
     /// direction `dir` (both ends included); `None` if any cell is not drivable.
     fn drive_line_cost(
@@ -1047,14 +1088,8 @@ impl<'c> HybridGraph<'c> {
         cells: i32,
         bin: HeadingBin,
     ) -> Option<f64> {
-        let res = self.lattice.resolution;
-        let mut sum = 0.0;
-        for k in 0..=cells {
-            let l = f64::from(k) * res;
-            let (c, _) = self.cell(p[0] + dir.0 * l, p[1] + dir.1 * l, bin).ok()?;
-            sum += c;
-        }
-        Some(sum / f64::from(cells + 1))
+        let (n, avg) = self.drivable_prefix(p, dir, cells, bin)?;
+        (n == cells).then_some(avg)
     }
 
     /// Appends the labelled non-driving successors of `s` (steps, base shifts, foot
@@ -1109,11 +1144,7 @@ impl<'c> HybridGraph<'c> {
         if o[0] > 0 && o[1] > 0 {
             // Every cell of the way must stand by the rule (the generator moves the base
             // through them), so the shift ends before the first that cannot.
-            let max = o[0].min(o[1]);
-            let mut l = 0;
-            while l < max && self.shift_in_reach(s, &feet, l + 1) {
-                l += 1;
-            }
+            let mut l = self.longest_shift_in_reach(s, &feet, o[0].min(o[1]));
             // The paper's shift ends where a rear leg reaches its full length. A rear leg
             // at full length cannot also lift its foot over an edge (its step stance
             // pitches the base less), so where a rear foot close to an obstacle could not
@@ -1153,6 +1184,19 @@ impl<'c> HybridGraph<'c> {
             self.push_base_shift(s, &o, &feet, l);
         }
 
+        // Climb shift (see the module docs): on a climb, with a rear foot close to an
+        // obstacle and the front feet not both ahead of neutral, as far past their
+        // neutral as every leg reaches, shortened to where a rear foot can still step.
+        let climbing = [0, 1].iter().any(|&f| {
+            [2, 3].iter().any(|&r| feet.h[f] - feet.h[r] > self.config.max_foot_height_diff_m)
+        });
+        if stairs && climbing && (near[2] || near[3]) && !(o[0] > 0 && o[1] > 0) {
+            let l = self.longest_shift_in_reach(s, &feet, self.shift_room(&o));
+            if let Some(l) = self.rear_step_ready_shift(s, &o, near, l) {
+                self.push_base_shift(s, &o, &feet, l);
+            }
+        }
+
         // Front wheel pairs forward, preparing a rear step: when a rear foot is close to
         // an obstacle (Sec. V). One move per foot, as far as the leg reaches and the
         // wheels can drive (at least `foot_move_increment_m`): shorter moves would only
@@ -1169,7 +1213,7 @@ impl<'c> HybridGraph<'c> {
         // footprints stay reachable, through a chain instead of every subset of feet
         // (2^4 intermediate footprints per pose become 4).
         if !neutral {
-            let moves = self.foot_neutral_moves(s, &o, &feet);
+            let moves = self.foot_neutral_moves(s, &o, &feet, near);
             self.push_first_feasible_move(s, &o, &moves);
         }
     }
@@ -1189,13 +1233,26 @@ impl<'c> HybridGraph<'c> {
         FootMove { kind, leg, to, cost, length_m }
     }
 
-    /// The wheel pairs back to neutral from `s` (offsets `o`, feet `feet`) whose way is
-    /// drivable, in FL, FR, RL, RR order (of which `special_successors` takes the first
-    /// that passes its checks).
-    fn foot_neutral_moves(&self, s: LatticeState, o: &FootOffsets, feet: &Feet) -> Vec<FootMove> {
+    /// The wheel pairs back toward neutral from `s` (offsets `o`, feet `feet`, criterion
+    /// 1 per foot `near`), in FL, FR, RL, RR order (of which `special_successors` takes
+    /// the first that passes its checks): to neutral where the way is drivable; with
+    /// `step_model = "stairs"`, a foot not close to an obstacle whose way is not, up to
+    /// the last drivable cell before the obstacle, where it is close to it. Without that, a rear foot behind neutral
+    /// short of a stair's riser could neither step (it is not close to the riser) nor
+    /// roll to neutral (the way climbs the riser), and no base shift brings it closer
+    /// while the front feet stand behind neutral on a tread: flights of four or more
+    /// steps had no path.
+    fn foot_neutral_moves(
+        &self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        near: [bool; 4],
+    ) -> Vec<FootMove> {
         let res = self.lattice.resolution;
         let heading = self.heading(s.theta);
         let bin = self.bin(s.theta);
+        let partial = self.config.motion.step_model == StepModel::Stairs;
         let mut moves = Vec::new();
         for leg in Leg::ALL {
             let k = leg.index();
@@ -1203,12 +1260,15 @@ impl<'c> HybridGraph<'c> {
                 continue;
             }
             let back = if o[k] > 0 { (-heading.0, -heading.1) } else { heading };
-            let cells = i32::from(o[k]).abs();
-            let Some(avg) = self.drive_line_cost(feet.pos[k], back, cells, bin) else {
-                continue;
+            let all = i32::from(o[k]).abs();
+            let (cells, avg) = match self.drivable_prefix(feet.pos[k], back, all, bin) {
+                Some((cells, avg)) if cells == all || (partial && cells > 0 && !near[k]) => {
+                    (cells, avg)
+                }
+                _ => continue,
             };
             let mut to = *o;
-            to[k] = 0;
+            to[k] = if o[k] > 0 { o[k] - cells as i8 } else { o[k] + cells as i8 };
             let length_m = f64::from(cells) * res;
             moves.push(self.foot_move(ManoeuvreKind::FootNeutral, leg, to, length_m, avg));
         }
@@ -1537,6 +1597,24 @@ impl<'c> HybridGraph<'c> {
         moved_d
     }
 
+    /// The longest shift of at most `max` cells from `s` (feet `feet`) whose every cell
+    /// of the way stands by the rule ([`Self::shift_in_reach`]): the generator moves the
+    /// base through them.
+    fn longest_shift_in_reach(&self, s: LatticeState, feet: &Feet, max: i8) -> i8 {
+        let mut l = 0;
+        while l < max && self.shift_in_reach(s, feet, l + 1) {
+            l += 1;
+        }
+        l
+    }
+
+    /// The most cells the base can shift forward over feet with offsets `o`: every
+    /// offset drops by the shift, and the leg with the least room behind it bounds it.
+    fn shift_room(&self, o: &FootOffsets) -> i8 {
+        let room = (0..4).map(|k| i32::from(o[k]) - i32::from(self.reach[k][0])).min();
+        room.map_or(0, |m| m.clamp(0, i32::from(i8::MAX)) as i8)
+    }
+
     /// Whether the robot can stand by the rule with its base `l` cells ahead of state
     /// `s`'s pose, over the same feet.
     fn shift_in_reach(&self, s: LatticeState, feet: &Feet, l: i8) -> bool {
@@ -1637,10 +1715,7 @@ impl<'c> HybridGraph<'c> {
         bin: HeadingBin,
     ) -> Option<i8> {
         let res = self.lattice.resolution;
-        // Every offset drops by l: the leg with the least room behind it bounds l.
-        let max = (0..4).map(|k| i32::from(o[k]) - i32::from(self.reach[k][0])).min()?;
-        let max = i8::try_from(max.clamp(0, i32::from(i8::MAX))).ok()?;
-        for l in 1..=max {
+        for l in 1..=self.shift_room(o) {
             if !self.shift_in_reach(s, feet, l) {
                 return None;
             }

@@ -453,6 +453,48 @@ mod hybrid {
         assert!(g.driving_pose_cost(s).is_some());
     }
 
+    #[test]
+    fn a_foot_short_of_an_edge_rolls_up_to_it_cost_eq_6() {
+        // Both front feet 0.4 m behind neutral, their neutral spots on the 0.2 m platform
+        // (x ≥ 1 m): the way to neutral climbs the edge, and FL is too far from it to
+        // step. Before, no move reached the edge and a rear foot short of a stair's riser
+        // stayed there (flights of four steps had no path). Stairs step model only.
+        let maps = platform_maps(0.2);
+        let params = Params { step_model: crate::params::StepModel::Stairs, ..Params::default() };
+        let c = HybridConfig::new(&params, &robot(), Neighbourhood::N16);
+        let goal = DrivingGoal::at(LatticeState::new(0, 0, 0));
+        let mut g = HybridGraph::new(&maps, &robot(), 64, c, goal).expect("graph");
+        let nfx = robot().neutral_footprint()[0][0];
+        let s = state_at(&g, 1.1 - nfx, 0.0);
+        let t = g.with_offsets(s, [-16, -16, 0, 0]).expect("interned");
+        let fms: Vec<_> = g
+            .labelled_successors(t)
+            .into_iter()
+            .filter(|(_, _, m)| m.kind == ManoeuvreKind::FootNeutral)
+            .collect();
+        assert_eq!(fms.len(), 1, "{fms:?}");
+        let (u, _, m) = fms[0];
+        assert_eq!(m.leg, Some(Leg::FrontLeft));
+        let to = g.offsets(u).expect("footprint")[0];
+        assert!((-15..0).contains(&to), "rolled to offset {to}");
+        // It stops at the last cell a wheel pair can drive on: one more cell is the edge's
+        // untraversable band.
+        let feet = g.feet(u).expect("feet");
+        let res = g.lattice().resolution;
+        let cf = |x: f64| maps.foot_cost_at_heading(x, feet[0][1], 0.0);
+        assert!(cf(feet[0][0]).is_finite());
+        assert!(!cf(feet[0][0] + res).is_finite());
+        // eq. 6 over the cells rolled, both ends included, times the step-related factor.
+        let from = g.feet(t).expect("feet")[0][0];
+        let cells = i32::from(to) + 16;
+        let avg = (0..=cells)
+            .map(|k| cf(from + f64::from(k) * res).finite().expect("drivable"))
+            .sum::<f64>()
+            / f64::from(cells + 1);
+        let expected = c.step_cost_factor * foot_move_cost(&c, f64::from(cells) * res, avg);
+        assert!((m.cost - expected).abs() < 1e-9, "{} vs {expected}", m.cost);
+    }
+
     /// The plain driving heuristic (Euclidean distance plus turn) of `s` in `g`.
     fn driving_heuristic(g: &HybridGraph<'_>, s: LatticeState) -> Cost {
         let l = *g.lattice();
@@ -778,6 +820,45 @@ mod hybrid {
                 proptest::prop_assert_eq!(old.best().map(|s| s.cost), new.best().map(|s| s.cost));
             }
         }
+    }
+
+    #[test]
+    fn a_flight_longer_than_the_robot_has_a_path() {
+        // Six steps of 0.17 m on 0.29 m treads (1.74 m of flight, the robot's feet span
+        // 0.8 m): with a rear foot short of a riser unable to roll up to it, and no base
+        // shift past the front feet's neutral while they stand on a tread, flights of
+        // four or more steps were searched exhaustively without a path.
+        let prims = [Primitive::Stairs {
+            start: [0.0, 0.0],
+            width: 1.8,
+            steps: 6,
+            step_depth: 0.29,
+            step_height: 0.17,
+            landing_depth: 1.5,
+            yaw_deg: 0.0,
+        }];
+        let m = rasterise(&prims, [-1.6, -1.2], [5.0, 2.4], 0.025).expect("map");
+        let params = Params {
+            step_model: crate::params::StepModel::Stairs,
+            foot_model: crate::params::FootModel::WheelPair,
+            ..Params::default()
+        };
+        let maps = CostMaps::build(&m, &robot(), &params).expect("maps");
+        let cfg = HybridConfig::new(&params, &robot(), Neighbourhood::N20);
+        let at = |x: f64| LatticeState::new(((x + 1.6) / 0.025) as i16, 48, 0);
+        let goal = DrivingGoal::at(at(2.6));
+        let mut g = HybridGraph::new(&maps, &robot(), 64, cfg, goal).expect("graph");
+        let search =
+            SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
+        let r = arastar(&mut g, at(-1.0), &search).expect("valid params");
+        let best = r.best().unwrap_or_else(|| panic!("no path: {:?}", r.termination));
+        let steps = best
+            .path
+            .windows(2)
+            .filter(|w| g.edge(w[0], w[1]).is_some_and(|(_, m)| m.kind == ManoeuvreKind::Step))
+            .count();
+        // Every foot climbs every riser (six each; the top one onto the landing).
+        assert_eq!(steps, 24);
     }
 
     #[test]
