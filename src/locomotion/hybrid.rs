@@ -1237,11 +1237,11 @@ impl<'c> HybridGraph<'c> {
     /// 1 per foot `near`), in FL, FR, RL, RR order (of which `special_successors` takes
     /// the first that passes its checks): to neutral where the way is drivable; with
     /// `step_model = "stairs"`, a foot not close to an obstacle whose way is not, up to
-    /// the last drivable cell before the obstacle, where it is close to it. Without that, a rear foot behind neutral
-    /// short of a stair's riser could neither step (it is not close to the riser) nor
-    /// roll to neutral (the way climbs the riser), and no base shift brings it closer
-    /// while the front feet stand behind neutral on a tread: flights of four or more
-    /// steps had no path.
+    /// the last drivable cell before the obstacle, where it is close to it. Without
+    /// that, a rear foot behind neutral short of a stair's riser could neither step (it
+    /// is not close to the riser) nor roll to neutral (the way climbs the riser), and no
+    /// base shift brings it closer while the front feet stand behind neutral on a tread:
+    /// flights of four or more steps had no path.
     fn foot_neutral_moves(
         &self,
         s: LatticeState,
