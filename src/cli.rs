@@ -213,6 +213,16 @@ pub struct PlannerArgs {
     /// initial ε to take the first solution, the same on any machine.
     #[arg(long, allow_negative_numbers = true)]
     pub final_epsilon: Option<f64>,
+    /// ε of ARA*'s greedy probe, searched before the schedule and kept as the answer if
+    /// a limit stops the schedule (default: the scenario's, 50); at most the initial ε
+    /// turns it off (the paper's ARA*).
+    #[arg(long, allow_negative_numbers = true)]
+    pub probe_epsilon: Option<f64>,
+    /// Cap on the search's expansions, all ARA* iterations together (default: none for
+    /// `plan` and `bench`; 1000000 for `run` and `check`, so that their plans do not depend
+    /// on the machine's speed).
+    #[arg(long)]
+    pub max_expansions: Option<u64>,
     /// Orientation cost factor k12 (default: the scenario's, 2.0).
     #[arg(long, allow_negative_numbers = true)]
     pub k12: Option<f64>,
@@ -246,6 +256,8 @@ impl PlannerArgs {
             },
             time_limit_s: self.time_limit,
             initial_epsilon: self.initial_epsilon,
+            probe_epsilon: self.probe_epsilon,
+            max_expansions: self.max_expansions,
             final_epsilon: self.final_epsilon,
             k12: self.k12,
             step_cost_factor: self.step_cost_factor,

@@ -16,6 +16,8 @@ use momaro::scenario::Scenario;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+mod common;
+
 fn robot() -> RobotDescription {
     momaro::sim::Simulation::robot_only(&momaro::sim::default_model_path())
         .expect("the model compiles")
@@ -354,4 +356,34 @@ height = 0.4
     // Invalid options.
     let bad = PlanOptions { time_limit_s: f64::NAN, ..PlanOptions::default() };
     assert!(matches!(run(&scenario("flat"), &robot(), &bad), Err(PlanJobError::BadOption { .. })));
+}
+
+/// ARA*'s probe (issue 15): on a generated up-and-over course (`generate --class
+/// up_and_over --seed 27`) the paper's ε = 3 search floods a plateau and is still without
+/// a path after 100,000 expansions; the probe at ε = 50 finds one within 200, and it is
+/// the answer when the cap stops the schedule, with its bound.
+#[test]
+fn the_probe_answers_where_the_schedule_runs_out() {
+    let s = common::generated(momaro::scenario::generate::Class::UpAndOver, 27);
+    let capped =
+        PlanOptions { final_epsilon: Some(3.0), max_expansions: Some(100_000), ..arastar(600.0) };
+    let paper = run(&s, &robot(), &PlanOptions { probe_epsilon: Some(3.0), ..capped.clone() });
+    assert!(
+        matches!(
+            paper,
+            Err(PlanJobError::NoPath {
+                termination: momaro::planner::Termination::ExpansionLimit,
+                ..
+            })
+        ),
+        "{paper:?}"
+    );
+    let p = plan(&s, &capped);
+    assert_eq!(p.termination, "expansion_limit");
+    assert_eq!(p.solutions.len(), 1);
+    let probe = &p.solutions[0];
+    assert_eq!(probe.epsilon, 50.0);
+    assert!(probe.expansions < 1_000, "{} expansions", probe.expansions);
+    assert!((1.0..=50.0).contains(&probe.suboptimality_bound), "{}", probe.suboptimality_bound);
+    assert!(!steps(&p).is_empty(), "the course is climbed");
 }

@@ -13,8 +13,10 @@
 //! `Simulation`, maps and planner; nothing is shared but the options), and sends the row
 //! back over a channel. Rows are reported as they finish (for progress) and returned in
 //! the input order; a run is deterministic given the planner options (ARA*'s first
-//! solution, `final_epsilon` = the initial ε), so the rows do not depend on the worker
-//! count, only their wall-clock fields do.
+//! solution, `final_epsilon` = the initial ε, or else the probe's path where the
+//! expansion cap `run::RUN_MAX_EXPANSIONS` stops the search), so the rows do not depend
+//! on the worker count, only their wall-clock fields do, as long as the time limit does
+//! not stop a search first.
 //!
 //! A file that does not load, or that the planner rejects as input (start off the map or
 //! on untraversable terrain, invalid options or parameters), is an

@@ -47,6 +47,12 @@ pub struct PlanOptions {
     pub time_limit_s: f64,
     /// ARA*'s initial heuristic weight; default `Params::arastar_initial_epsilon` (3.0).
     pub initial_epsilon: Option<f64>,
+    /// ε of ARA*'s greedy probe before the schedule; default
+    /// `Params::arastar_probe_epsilon` (50). At most the initial ε: no probe.
+    pub probe_epsilon: Option<f64>,
+    /// Cap on the search's expansions (all iterations, the probe included): with it, a
+    /// search cut short ends in the same place on any machine. Default none.
+    pub max_expansions: Option<u64>,
     /// ARA* stops once a solution with this ε is found (default 1: the optimum). Equal
     /// to the initial ε, the first solution is taken: the same plan on any machine, where
     /// a time limit cuts the anytime search wherever the CPU happens to be.
@@ -70,6 +76,8 @@ impl Default for PlanOptions {
             algorithm: Algorithm::AraStar,
             time_limit_s: 10.0,
             initial_epsilon: None,
+            probe_epsilon: None,
+            max_expansions: None,
             final_epsilon: None,
             k12: None,
             step_cost_factor: None,
@@ -619,6 +627,11 @@ pub fn run(
     {
         return Err(bad("initial_epsilon", format!("{e} must be at least 1")));
     }
+    if let Some(e) = opts.probe_epsilon
+        && !(e.is_finite() && e >= 1.0)
+    {
+        return Err(bad("probe_epsilon", format!("{e} must be at least 1")));
+    }
     if let Some(k) = opts.k12
         && !(k.is_finite() && k >= 1.0)
     {
@@ -640,8 +653,11 @@ pub fn run(
     let mut graph = prep.graph(robot, neighbourhood, prep.params.k12).map_err(lattice_err)?;
     graph.forbid(&opts.forbidden);
     let eps0 = opts.initial_epsilon.unwrap_or(prep.params.arastar_initial_epsilon);
+    let probe = opts.probe_epsilon.unwrap_or(prep.params.arastar_probe_epsilon);
     let search_params = SearchParams {
         initial_epsilon: eps0,
+        probe_epsilon: (probe > eps0).then_some(probe),
+        max_expansions: opts.max_expansions,
         final_epsilon: opts.final_epsilon.unwrap_or(1.0).min(eps0),
         epsilon_decay: prep.params.arastar_epsilon_decay,
         time_limit: Some(limit.saturating_sub(t0.elapsed())),

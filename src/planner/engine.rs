@@ -43,6 +43,8 @@ pub(crate) struct Engine<'g, 'h, G: SearchGraph> {
     /// The goal state with the smallest `g` generated so far.
     pub goal: Option<NodeId>,
     policy: ClosedPolicy,
+    /// `SearchParams::max_states`, for [`Engine::restart`].
+    max_states: Option<usize>,
 }
 
 impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
@@ -73,22 +75,42 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             iter: 0,
             goal: None,
             policy,
+            max_states: params.max_states,
         };
-        if let Some(id) = engine.store.get_or_insert(&*engine.graph, start) {
-            let n = engine.store.get_mut(id);
+        engine.seed(start);
+        engine
+    }
+
+    /// `g(start) = 0`, OPEN = {start} at the current ε.
+    fn seed(&mut self, start: G::State) {
+        let eps = self.eps;
+        if let Some(id) = self.store.get_or_insert(&*self.graph, start) {
+            let n = self.store.get_mut(id);
             n.g = Cost::ZERO;
             let (h, goal) = (n.h, n.is_goal());
             if goal {
-                engine.goal = Some(id);
+                self.goal = Some(id);
             }
             // An infinite heuristic proves that no path leaves the start: OPEN stays
             // empty and the search ends at once with no path.
             if goal || !h.is_infinite() {
                 n.set_open(true);
-                engine.open.push(Entry { key: weighted_key(Cost::ZERO, h, eps), h: h.0, node: id });
+                self.open.push(Entry { key: weighted_key(Cost::ZERO, h, eps), h: h.0, node: id });
             }
         }
-        engine
+    }
+
+    /// Starts over from `start` at ε = `eps` with no state known (a fresh search), keeping
+    /// the limits, the expansion count, the hooks and the published solutions: ARA*'s
+    /// schedule after its probe.
+    pub fn restart(&mut self, start: G::State, eps: u64) {
+        self.store = NodeStore::new(self.max_states, self.graph.dense_len());
+        self.open = OpenList::new();
+        self.incons.clear();
+        self.goal = None;
+        self.eps = eps;
+        self.iter += 1;
+        self.seed(start);
     }
 
     /// Whether an OPEN entry is current: its state is still in OPEN with this key at `eps`.

@@ -13,8 +13,13 @@ pub const EPS_SCALE: u64 = 1000;
 /// exponentially to 1.0, Klamt & Behnke 2017, Sec. VII-B) with no limits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SearchParams {
-    /// ARA*: ε of the first search (≥ 1; rounded to 0.001). Paper: 3.0.
+    /// ARA*: ε of the first search of the schedule (≥ 1; rounded to 0.001). Paper: 3.0.
     pub initial_epsilon: f64,
+    /// ARA*: ε of a greedy search run before the schedule (≥ `initial_epsilon`; equal:
+    /// none), or `None` for the paper's schedule alone. Its solution is published with
+    /// its bound ε′ and kept as the answer should a limit stop the schedule, which then
+    /// starts from scratch (`arastar`). Not in the paper.
+    pub probe_epsilon: Option<f64>,
     /// ARA*: ε of the last search (≥ 1, ≤ `initial_epsilon`). 1.0 proves optimality.
     pub final_epsilon: f64,
     /// ARA*: after each solution, `ε − final_epsilon` is multiplied by this factor
@@ -37,6 +42,7 @@ impl Default for SearchParams {
     fn default() -> Self {
         Self {
             initial_epsilon: 3.0,
+            probe_epsilon: None,
             final_epsilon: 1.0,
             epsilon_decay: 0.5,
             epsilon_snap: 0.01,
@@ -58,6 +64,14 @@ pub enum ParamsError {
         /// Offending value.
         value: f64,
     },
+    /// `probe_epsilon < initial_epsilon`.
+    #[error("probe_epsilon = {probe} is below initial_epsilon = {initial}")]
+    ProbeOrder {
+        /// `probe_epsilon`.
+        probe: f64,
+        /// `initial_epsilon`.
+        initial: f64,
+    },
     /// `initial_epsilon < final_epsilon`.
     #[error("initial_epsilon = {initial} is below final_epsilon = {final_epsilon}")]
     EpsilonOrder {
@@ -77,6 +91,8 @@ pub enum ParamsError {
 /// The validated ε schedule in fixed point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct EpsilonSchedule {
+    /// ε of the probe, when there is one above `initial`.
+    pub probe: Option<u64>,
     pub initial: u64,
     pub final_: u64,
     decay: u64, // per mille of the gap kept, 1..=999
@@ -102,6 +118,19 @@ impl SearchParams {
     pub(crate) fn schedule(&self) -> Result<EpsilonSchedule, ParamsError> {
         let initial = to_milli("initial_epsilon", self.initial_epsilon)?;
         let final_ = to_milli("final_epsilon", self.final_epsilon)?;
+        let probe = match self.probe_epsilon {
+            Some(p) => {
+                let probe = to_milli("probe_epsilon", p)?;
+                if probe < initial {
+                    return Err(ParamsError::ProbeOrder {
+                        probe: p,
+                        initial: self.initial_epsilon,
+                    });
+                }
+                (probe > initial).then_some(probe)
+            }
+            None => None,
+        };
         if initial < final_ {
             return Err(ParamsError::EpsilonOrder {
                 initial: self.initial_epsilon,
@@ -116,11 +145,16 @@ impl SearchParams {
         }
         let decay = ((self.epsilon_decay * EPS_SCALE as f64).round() as u64).clamp(1, 999);
         let snap = (self.epsilon_snap.min(1e9) * EPS_SCALE as f64).round() as u64;
-        Ok(EpsilonSchedule { initial, final_, decay, snap })
+        Ok(EpsilonSchedule { probe, initial, final_, decay, snap })
     }
 }
 
 impl EpsilonSchedule {
+    /// ε of the first search: the probe's, or the schedule's first.
+    pub fn first(&self) -> u64 {
+        self.probe.unwrap_or(self.initial)
+    }
+
     /// The ε after `eps` (both in milli): `final + (eps − final)·decay`, rounded, strictly
     /// smaller than `eps`, snapped to `final` once the gap is below `snap`.
     pub fn next(&self, eps: u64) -> u64 {

@@ -73,6 +73,60 @@ fn weighted_astar_is_suboptimal_on_trap() {
 }
 
 #[test]
+fn a_probe_publishes_first_and_the_schedule_still_finds_the_optimum() {
+    // The probe (ε = 10) takes the trap's route through A; the schedule, from scratch at
+    // ε = 1, the optimum through B.
+    let p =
+        SearchParams { probe_epsilon: Some(10.0), initial_epsilon: 1.0, ..SearchParams::default() };
+    let r = arastar(&mut trap(), S, &p).expect("valid params");
+    assert_eq!(r.termination, Termination::OptimalProven);
+    let got: Vec<(f64, Cost)> = r.solutions.iter().map(|s| (s.epsilon, s.cost)).collect();
+    assert_eq!(got, vec![(10.0, units(6)), (1.0, units(4))]);
+    assert_eq!(r.best().expect("solution").path, vec![S, B, G]);
+    // ε′ of the probe's path: 6 / min(g + h over OPEN) = 6 / (3 + 1).
+    assert!((r.solutions[0].suboptimality_bound - 1.5).abs() < 1e-12);
+}
+
+#[test]
+fn a_limit_on_the_schedule_leaves_the_probes_path() {
+    // The probe expands S and A (2); the schedule stops at its first expansion.
+    let p = SearchParams {
+        probe_epsilon: Some(10.0),
+        initial_epsilon: 1.0,
+        max_expansions: Some(3),
+        ..SearchParams::default()
+    };
+    let r = arastar(&mut trap(), S, &p).expect("valid params");
+    assert_eq!(r.termination, Termination::ExpansionLimit);
+    let best = r.best().expect("the probe's solution");
+    assert_eq!((best.path.clone(), best.cost, best.epsilon), (vec![S, A, G], units(6), 10.0));
+    assert_eq!(r.expansions, 3);
+}
+
+#[test]
+fn a_certified_bound_at_the_final_epsilon_ends_the_schedule() {
+    // ε = 3 finds the route through A with ε′ = 1.5: what a search at the final ε = 1.5
+    // would prove, so none runs.
+    let p = SearchParams { initial_epsilon: 3.0, final_epsilon: 1.5, ..SearchParams::default() };
+    let r = arastar(&mut trap(), S, &p).expect("valid params");
+    assert_eq!(r.termination, Termination::FinalEpsilonReached);
+    assert_eq!(r.solutions.len(), 1);
+    assert!((r.solutions[0].suboptimality_bound - 1.5).abs() < 1e-12);
+}
+
+#[test]
+fn a_probe_below_the_initial_epsilon_is_rejected() {
+    let p = SearchParams { probe_epsilon: Some(2.0), ..SearchParams::default() };
+    assert!(matches!(
+        arastar(&mut trap(), S, &p),
+        Err(SearchError::Params(ParamsError::ProbeOrder { .. }))
+    ));
+    let same = SearchParams { probe_epsilon: Some(3.0), ..SearchParams::default() };
+    let r = arastar(&mut trap(), S, &same).expect("a probe at the initial ε is none");
+    assert_eq!(r.solutions[0].epsilon, 3.0);
+}
+
+#[test]
 fn arastar_improves_the_trap_solution() {
     let r = arastar(&mut trap(), S, &SearchParams::default()).expect("valid params");
     assert_eq!(r.termination, Termination::OptimalProven);
