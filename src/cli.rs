@@ -79,6 +79,9 @@ pub enum Command {
     /// Measure speed (medians over repeats; never asserted in tests).
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// What the robot can do, swept in closed loop.
+    #[command(subcommand)]
+    Envelope(EnvelopeCommand),
     /// Plan a hybrid driving-stepping path for a scenario (A* or anytime ARA*).
     Plan {
         /// Scenario file.
@@ -218,11 +221,11 @@ pub struct PlannerArgs {
     /// turns it off (the paper's ARA*).
     #[arg(long, allow_negative_numbers = true)]
     pub probe_epsilon: Option<f64>,
-    /// Cap on the search's expansions, all ARA* iterations together (default: none for
-    /// `plan` and `bench`; 1000000 for `run` and `check`, so that their plans do not depend
-    /// on the machine's speed).
+    /// Expansions ARA*'s schedule may spend once the probe has found a path, after which
+    /// the probe's path is the answer (default: none for `plan`; 1000000 for `run`,
+    /// `check` and `envelope`, so that their plans do not depend on the machine's speed).
     #[arg(long)]
-    pub max_expansions: Option<u64>,
+    pub schedule_expansions: Option<u64>,
     /// Orientation cost factor k12 (default: the scenario's, 2.0).
     #[arg(long, allow_negative_numbers = true)]
     pub k12: Option<f64>,
@@ -257,7 +260,7 @@ impl PlannerArgs {
             time_limit_s: self.time_limit,
             initial_epsilon: self.initial_epsilon,
             probe_epsilon: self.probe_epsilon,
-            max_expansions: self.max_expansions,
+            schedule_expansions: self.schedule_expansions,
             final_epsilon: self.final_epsilon,
             k12: self.k12,
             step_cost_factor: self.step_cost_factor,
@@ -309,6 +312,53 @@ pub enum BenchCommand {
         #[command(flatten)]
         model: ModelArgs,
     },
+}
+
+/// The envelopes.
+#[derive(Debug, Subcommand)]
+pub enum EnvelopeCommand {
+    /// Straight flights over rise × tread, up and down, each in closed loop (`check`'s
+    /// workers): a table (or JSON) on stdout, the cells' scenarios, `envelope.json` and
+    /// the heat map `envelope.png` in OUT. Exit 0 if no cell lost its stability.
+    Stairs {
+        /// Rises, m, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [0.10, 0.12, 0.14, 0.16, 0.18, 0.20, 0.22])]
+        rises: Vec<f64>,
+        /// Treads, m, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [0.25, 0.27, 0.30, 0.35, 0.40])]
+        treads: Vec<f64>,
+        /// Steps per flight.
+        #[arg(long, default_value_t = 3)]
+        steps: u32,
+        /// Which way: up, down or both.
+        #[arg(long, value_enum, default_value_t = DirectionArg::Both)]
+        direction: DirectionArg,
+        /// Output directory.
+        #[arg(long, value_name = "DIR", default_value = "out/envelope")]
+        out: PathBuf,
+        #[command(flatten)]
+        planner: PlannerArgs,
+        /// Worker threads (default: the available parallelism). Results do not depend on
+        /// it.
+        #[arg(long, value_name = "N")]
+        jobs: Option<usize>,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+}
+
+/// `envelope stairs --direction`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DirectionArg {
+    /// Climb.
+    Up,
+    /// Descend.
+    Down,
+    /// Both.
+    Both,
 }
 
 /// `--class`: one of the generator's class names (listed by `--help`).
@@ -456,6 +506,43 @@ fn check(
         FailOn::All => report.all_passed(),
         FailOn::Safety => report.safe(),
     })
+}
+
+/// `momaro envelope stairs`: the cells' rows on stderr as they finish, then the table (or
+/// JSON) on stdout; `envelope.json` beside the heat map.
+fn envelope_stairs(opts: jobs::envelope::EnvelopeOptions, json: bool) -> anyhow::Result<bool> {
+    use jobs::envelope::{self, EnvelopeError};
+    let report = envelope::run(&opts, &mut |f| {
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
+            "[{}/{}] {:<28} {}",
+            f.done,
+            f.total,
+            f.row.scenario,
+            envelope::CellVerdict::of(f.row).name()
+        );
+    })
+    .map_err(|e| match e {
+        EnvelopeError::BadOption { .. } => anyhow::Error::new(BadInput(e.to_string())),
+        EnvelopeError::Check(c) => check_error(c),
+        e => anyhow::Error::new(e),
+    })?;
+    let json_path = opts.out_dir.join("envelope.json");
+    std::fs::write(&json_path, serde_json::to_string_pretty(&report)?)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", json_path.display()))?;
+    if json {
+        print_json(&report)?;
+    } else {
+        say!("{}", envelope::table(&report));
+        say!(
+            "heat map: {} (green climbs, grey no path, blue planner limit, orange other",
+            report.png.display()
+        );
+        say!("failure, red unstable; rises bottom to top, treads left to right, one panel per");
+        say!("direction); JSON: {}", json_path.display());
+    }
+    Ok(report.stable_everywhere())
 }
 
 fn print_check_table(report: &jobs::check::CheckReport) {
@@ -807,6 +894,42 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
         }
         Command::Check { paths, planner, jobs, shard, fail_on, json, model } => {
             check(&paths, &planner, jobs, shard.as_deref(), fail_on, json, model.model)
+        }
+        Command::Envelope(EnvelopeCommand::Stairs {
+            rises,
+            treads,
+            steps,
+            direction,
+            out,
+            planner,
+            jobs,
+            json,
+            model,
+        }) => {
+            use jobs::envelope::{Direction, EnvelopeOptions};
+            let directions = match direction {
+                DirectionArg::Up => vec![Direction::Up],
+                DirectionArg::Down => vec![Direction::Down],
+                DirectionArg::Both => vec![Direction::Up, Direction::Down],
+            };
+            let workers =
+                jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+            // ARA*'s first solution unless asked otherwise: the same plan on any machine.
+            let mut plan = planner.options();
+            plan.final_epsilon = plan.final_epsilon.or(plan.initial_epsilon).or(Some(3.0));
+            let opts = EnvelopeOptions {
+                rises_m: rises,
+                treads_m: treads,
+                steps,
+                directions,
+                out_dir: out,
+                check: jobs::check::CheckOptions {
+                    run: jobs::run::RunOptions::new(plan, model.model),
+                    jobs: workers,
+                    shard: None,
+                },
+            };
+            envelope_stairs(opts, json)
         }
         Command::Bench(BenchCommand::Plan {
             scenario,

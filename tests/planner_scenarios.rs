@@ -365,9 +365,14 @@ height = 0.4
 #[test]
 fn the_probe_answers_where_the_schedule_runs_out() {
     let s = common::generated(momaro::scenario::generate::Class::UpAndOver, 27);
-    let capped =
-        PlanOptions { final_epsilon: Some(3.0), max_expansions: Some(100_000), ..arastar(600.0) };
-    let paper = run(&s, &robot(), &PlanOptions { probe_epsilon: Some(3.0), ..capped.clone() });
+    let capped = PlanOptions {
+        final_epsilon: Some(3.0),
+        schedule_expansions: Some(100_000),
+        ..arastar(600.0)
+    };
+    let paper =
+        PlanOptions { probe_epsilon: Some(3.0), max_expansions: Some(100_000), ..capped.clone() };
+    let paper = run(&s, &robot(), &paper);
     assert!(
         matches!(
             paper,

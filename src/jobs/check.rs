@@ -14,7 +14,7 @@
 //! back over a channel. Rows are reported as they finish (for progress) and returned in
 //! the input order; a run is deterministic given the planner options (ARA*'s first
 //! solution, `final_epsilon` = the initial ε, or else the probe's path where the
-//! expansion cap `run::RUN_MAX_EXPANSIONS` stops the search), so the rows do not depend
+//! schedule's cap `run::RUN_SCHEDULE_EXPANSIONS` stops it), so the rows do not depend
 //! on the worker count, only their wall-clock fields do, as long as the time limit does
 //! not stop a search first.
 //!

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod check;
 pub mod costmap;
 pub mod detailed;
+pub mod envelope;
 pub mod generate;
 pub mod plan;
 pub mod plan_recording;

@@ -50,8 +50,11 @@ pub struct PlanOptions {
     /// ε of ARA*'s greedy probe before the schedule; default
     /// `Params::arastar_probe_epsilon` (50). At most the initial ε: no probe.
     pub probe_epsilon: Option<f64>,
-    /// Cap on the search's expansions (all iterations, the probe included): with it, a
-    /// search cut short ends in the same place on any machine. Default none.
+    /// Expansions ARA*'s schedule may spend after its probe found a path
+    /// (`SearchParams::schedule_max_expansions`): the probe's path is then the answer
+    /// on any machine. Default none.
+    pub schedule_expansions: Option<u64>,
+    /// Cap on the whole search's expansions (`SearchParams::max_expansions`). Default none.
     pub max_expansions: Option<u64>,
     /// ARA* stops once a solution with this ε is found (default 1: the optimum). Equal
     /// to the initial ε, the first solution is taken: the same plan on any machine, where
@@ -77,6 +80,7 @@ impl Default for PlanOptions {
             time_limit_s: 10.0,
             initial_epsilon: None,
             probe_epsilon: None,
+            schedule_expansions: None,
             max_expansions: None,
             final_epsilon: None,
             k12: None,
@@ -657,6 +661,7 @@ pub fn run(
     let search_params = SearchParams {
         initial_epsilon: eps0,
         probe_epsilon: (probe > eps0).then_some(probe),
+        schedule_max_expansions: opts.schedule_expansions,
         max_expansions: opts.max_expansions,
         final_epsilon: opts.final_epsilon.unwrap_or(1.0).min(eps0),
         epsilon_decay: prep.params.arastar_epsilon_decay,

@@ -87,6 +87,10 @@ pub fn arastar_with_hooks<G: SearchGraph>(
             return Ok(engine.finish(stop));
         }
         engine.restart(start, schedule.initial);
+        if let Some(n) = params.schedule_max_expansions {
+            let at = engine.expansions.saturating_add(n);
+            engine.limits.cap_expansions(at);
+        }
     }
     let termination = loop {
         // line 03' / 09': ImprovePath()

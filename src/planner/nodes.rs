@@ -321,6 +321,11 @@ impl<'a> Limits<'a> {
         }
     }
 
+    /// Lowers the expansion cap to `at` (expansions counted from the search's start).
+    pub fn cap_expansions(&mut self, at: u64) {
+        self.max_expansions = Some(self.max_expansions.map_or(at, |m| m.min(at)));
+    }
+
     /// Whether the search must stop before the next expansion (`expansions` done so far).
     #[inline]
     pub fn check(&mut self, expansions: u64) -> Option<Termination> {

@@ -33,6 +33,11 @@ pub struct SearchParams {
     pub time_limit: Option<Duration>,
     /// Cap on expansions, counted over all iterations.
     pub max_expansions: Option<u64>,
+    /// ARA*: once the probe has found a path, the expansions the schedule may spend
+    /// after it (a cap that leaves the probe's path as the answer on any machine, where a
+    /// time limit stops wherever the CPU happens to be). Without a probe's path, no cap:
+    /// a search that would prove "no path" is not cut short.
+    pub schedule_max_expansions: Option<u64>,
     /// Cap on generated states (memory guard for huge graphs). The index type caps it
     /// at `u32::MAX − 1` in any case.
     pub max_states: Option<usize>,
@@ -48,6 +53,7 @@ impl Default for SearchParams {
             epsilon_snap: 0.01,
             time_limit: None,
             max_expansions: None,
+            schedule_max_expansions: None,
             max_states: None,
         }
     }

@@ -89,18 +89,23 @@ fn a_probe_publishes_first_and_the_schedule_still_finds_the_optimum() {
 
 #[test]
 fn a_limit_on_the_schedule_leaves_the_probes_path() {
-    // The probe expands S and A (2); the schedule stops at its first expansion.
+    // The probe expands S and A (2); the schedule may spend one expansion after it.
     let p = SearchParams {
         probe_epsilon: Some(10.0),
         initial_epsilon: 1.0,
-        max_expansions: Some(3),
+        schedule_max_expansions: Some(1),
         ..SearchParams::default()
     };
     let r = arastar(&mut trap(), S, &p).expect("valid params");
     assert_eq!(r.termination, Termination::ExpansionLimit);
     let best = r.best().expect("the probe's solution");
-    assert_eq!((best.path.clone(), best.cost, best.epsilon), (vec![S, A, G], units(6), 10.0));
+    assert_eq!((best.path.clone(), best.cost), (vec![S, A, G], units(6)));
+    assert_eq!(best.epsilon, 10.0);
     assert_eq!(r.expansions, 3);
+    // Without a probe there is no probe's path to keep: the cap does not apply.
+    let p = SearchParams { schedule_max_expansions: Some(0), ..SearchParams::default() };
+    let r = arastar(&mut trap(), S, &p).expect("valid params");
+    assert_eq!(r.termination, Termination::OptimalProven);
 }
 
 #[test]
