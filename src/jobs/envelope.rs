@@ -272,8 +272,9 @@ fn check_options(opts: &EnvelopeOptions) -> Result<(), EnvelopeError> {
     Ok(())
 }
 
-/// Writes the cells' scenarios, runs them, writes `envelope.json`'s content's source (the
-/// report) and `envelope.png`; `on_finished` sees each run as it ends.
+/// Writes the cells' scenarios to `OUT/scenarios/`, runs them, writes the heat map
+/// `OUT/envelope.png` and returns the report (which the command writes as
+/// `OUT/envelope.json`); `on_finished` sees each run as it ends.
 ///
 /// # Errors
 /// [`EnvelopeError`]: a bad option, a file that cannot be written, a suite that cannot run.
