@@ -463,7 +463,7 @@ fn check(
 ) -> anyhow::Result<bool> {
     use jobs::check;
     let shard = shard.map(str::parse::<check::Shard>).transpose().map_err(check_error)?;
-    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let jobs = workers_or_all(jobs);
     let files = if paths.is_empty() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
         check::repository_scenarios(&dir)
@@ -506,6 +506,11 @@ fn check(
         FailOn::All => report.all_passed(),
         FailOn::Safety => report.safe(),
     })
+}
+
+/// `--jobs`, or one worker per available core.
+fn workers_or_all(jobs: Option<usize>) -> usize {
+    jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
 /// `momaro envelope stairs`: the cells' rows on stderr as they finish, then the table (or
@@ -912,8 +917,7 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 DirectionArg::Down => vec![Direction::Down],
                 DirectionArg::Both => vec![Direction::Up, Direction::Down],
             };
-            let workers =
-                jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+            let workers = workers_or_all(jobs);
             // ARA*'s first solution unless asked otherwise: the same plan on any machine.
             let mut plan = planner.options();
             plan.final_epsilon = plan.final_epsilon.or(plan.initial_epsilon).or(Some(3.0));

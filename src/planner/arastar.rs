@@ -70,18 +70,11 @@ pub fn arastar_with_hooks<G: SearchGraph>(
         // far; then the schedule from scratch, so that it finds what the paper's ARA*
         // finds (a search on the probe's g values would stop at once wherever the probe's
         // path already meets the bound, with the probe's poorer path).
-        match engine.improve_path() {
-            Err(stop) => return Ok(engine.finish(stop)),
-            Ok(()) => {
-                let Some(goal) = engine.goal else {
-                    return Ok(engine.finish(Termination::NoPath));
-                };
-                let lower = engine.lower_bound();
-                let (path, cost) = engine.path_to(goal);
-                let bound = suboptimality_bound(engine.eps, cost, lower);
-                engine.publish(path.clone(), cost, bound);
-                best = Some((path, cost));
-            }
+        if let Err(stop) = engine.improve_path() {
+            return Ok(engine.finish(stop));
+        }
+        if publish_best(&mut engine, &mut best).is_none() {
+            return Ok(engine.finish(Termination::NoPath));
         }
         if let Some(stop) = engine.limits.check_now() {
             return Ok(engine.finish(stop));
@@ -97,20 +90,10 @@ pub fn arastar_with_hooks<G: SearchGraph>(
         if let Err(stop) = engine.improve_path() {
             break stop;
         }
-        let Some(goal) = engine.goal else {
+        // lines 04' / 10': ε′ and publish the current ε′-suboptimal solution
+        let Some(bound) = publish_best(&mut engine, &mut best) else {
             break Termination::NoPath; // OPEN ran empty without reaching a goal
         };
-        // lines 04' / 10': ε′ and publish the current ε′-suboptimal solution
-        let lower = engine.lower_bound();
-        let (path, cost) = engine.path_to(goal);
-        if best.as_ref().is_none_or(|(_, c)| cost <= *c) {
-            best = Some((path, cost));
-        }
-        let Some((path, cost)) = best.clone() else {
-            break Termination::NoPath;
-        };
-        let bound = suboptimality_bound(engine.eps, cost, lower);
-        engine.publish(path, cost, bound);
         // line 05': while ε′ > 1
         if bound <= 1.0 {
             break Termination::OptimalProven;
@@ -130,4 +113,23 @@ pub fn arastar_with_hooks<G: SearchGraph>(
         engine.next_iteration(schedule.next(engine.eps));
     };
     Ok(engine.finish(termination))
+}
+
+/// After an `ImprovePath`: the path to the engine's goal becomes `best` unless `best` is
+/// cheaper, and `best` is published with its bound ε′ (Likhachev et al. 2003, Fig. 3,
+/// lines 04' and 10'), which is returned; `None` if no goal was reached.
+fn publish_best<G: SearchGraph>(
+    engine: &mut Engine<'_, '_, G>,
+    best: &mut Option<(Vec<G::State>, super::Cost)>,
+) -> Option<f64> {
+    let goal = engine.goal?;
+    let lower = engine.lower_bound();
+    let (path, cost) = engine.path_to(goal);
+    if best.as_ref().is_none_or(|(_, c)| cost <= *c) {
+        *best = Some((path, cost));
+    }
+    let (path, cost) = best.clone()?;
+    let bound = suboptimality_bound(engine.eps, cost, lower);
+    engine.publish(path, cost, bound);
+    Some(bound)
 }

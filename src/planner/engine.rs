@@ -43,8 +43,6 @@ pub(crate) struct Engine<'g, 'h, G: SearchGraph> {
     /// The goal state with the smallest `g` generated so far.
     pub goal: Option<NodeId>,
     policy: ClosedPolicy,
-    /// `SearchParams::max_states`, for [`Engine::restart`].
-    max_states: Option<usize>,
 }
 
 impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
@@ -75,7 +73,6 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             iter: 0,
             goal: None,
             policy,
-            max_states: params.max_states,
         };
         engine.seed(start);
         engine
@@ -104,7 +101,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     /// the limits, the expansion count, the hooks and the published solutions: ARA*'s
     /// schedule after its probe.
     pub fn restart(&mut self, start: G::State, eps: u64) {
-        self.store = NodeStore::new(self.max_states, self.graph.dense_len());
+        self.store.clear();
         self.open = OpenList::new();
         self.incons.clear();
         self.goal = None;

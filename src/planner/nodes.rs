@@ -196,6 +196,14 @@ impl<S: Copy + Eq + std::hash::Hash> NodeStore<S> {
         }
     }
 
+    /// Forgets every state (its limit kept), for a search that starts over.
+    pub fn clear(&mut self) {
+        self.index.clear();
+        // A fresh zeroed vector, not a fill: its pages are mapped lazily, as in `new`.
+        self.dense = vec![0; self.dense.len()];
+        self.nodes.clear();
+    }
+
     /// Appends a new node for `state` (g = ∞, h and goal flag from `graph`); `None` when
     /// the store is full.
     #[inline]
