@@ -285,6 +285,19 @@ pub struct HybridConfig {
     pub motion: MotionOptions,
 }
 
+/// How the robot stands on a footprint at a lattice pose (`HybridGraph::stand`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stand {
+    /// No height of the standing rule reaches every foot clear of the terrain, or the
+    /// body would touch it.
+    No,
+    /// The rule's posture stands, its legs clear of the leg terrain.
+    Stands,
+    /// It also clears the swept leg terrain: a wheel move between two such postures
+    /// needs no check in between (`HybridGraph::wheel_move_feasible`).
+    SweptClear,
+}
+
 /// The [`LatticeState::step_pending`] tag of leg index `k` (0..4).
 fn leg_tag(k: usize) -> u8 {
     k as u8 + 1
@@ -421,10 +434,16 @@ pub struct HybridGraph<'c> {
     /// [`Self::target_ok`] of non-neutral footprints by (cell, orientation, offsets): a
     /// footprint is entered from several predecessors, and each check runs the standing
     /// rule's IK.
-    standable: HashMap<(i16, i16, u8, FootOffsets), bool, FxBuild>,
+    standable: HashMap<(i16, i16, u8, FootOffsets), Stand, FxBuild>,
     /// [`Self::step_feasible`] by the state a step starts from, the leg and its new
     /// offset: ARA* expands a state again in each iteration.
     step_checks: HashMap<(PoseKey, u8, i8), bool, FxBuild>,
+    /// [`Self::wheel_segment_ok`] by the pose and footprint a one-cell wheel move starts
+    /// from, the leg and its new offset.
+    wheel_move_checks: HashMap<(PoseKey, u8, i8), bool, FxBuild>,
+    /// [`Self::base_shift_feasible`] by the state a shift starts from (cell, orientation,
+    /// footprint id) and the cell it ends on.
+    base_shift_checks: HashMap<(i16, i16, u8, u16, i16, i16), bool, FxBuild>,
 }
 
 /// The parts of the hybrid heuristic of a state (`HybridGraph::heuristic_parts`):
@@ -600,6 +619,8 @@ impl<'c> HybridGraph<'c> {
             cost_to_go,
             heuristic_setup,
             standable: HashMap::default(),
+            wheel_move_checks: HashMap::default(),
+            base_shift_checks: HashMap::default(),
             step_checks: HashMap::default(),
         })
     }
@@ -848,20 +869,20 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// Leg heights (hip above the foot's ground, m) of the standing rule for the robot at
-    /// state `s`'s pose on feet `feet`; `None` if no leg height of the rule reaches every
-    /// foot (see the module docs).
-    fn standing_legs(&self, s: LatticeState, feet: &Feet) -> Option<[f64; 4]> {
+    /// state `s`'s pose on feet `feet`, and whether its thighs and shins also clear the
+    /// swept leg terrain ([`CostMaps::swept_leg_terrain`]); `None` if no leg height of the
+    /// rule reaches every foot (see the module docs).
+    fn standing_legs(&self, s: LatticeState, feet: &Feet) -> Option<([f64; 4], bool)> {
         let pose = self.lattice.pose(s);
         let world = Self::feet_xyz(feet);
-        let (p, _) = self
-            .config
-            .motion
-            .standing
-            .stand(&self.robot, self.maps.leg_terrain(), world, [pose.x, pose.y], pose.theta)
+        let rule = &self.config.motion.standing;
+        let (p, _, legs) = rule
+            .stand_legs(&self.robot, self.maps.leg_terrain(), world, [pose.x, pose.y], pose.theta)
             .ok()?;
         self.feasibility.body_clear(&p, self.maps).ok()?;
         let hips = hips_in_world(&self.robot, &p);
-        Some(std::array::from_fn(|k| hips[k][2] - world[k][2]))
+        let swept = rule.legs_clear(&self.robot, self.maps.swept_leg_terrain(), &legs).is_ok();
+        Some((std::array::from_fn(|k| hips[k][2] - world[k][2]), swept))
     }
 
     /// Whether a non-neutral footprint keeps the wheel pairs apart.
@@ -921,25 +942,49 @@ impl<'c> HybridGraph<'c> {
         {
             return false;
         }
+        self.stand(t, o) != Stand::No
+    }
+
+    /// How the robot stands at `t`'s pose on footprint `o` ([`Stand`], memoised): the
+    /// shared rule's standing posture ([`Self::standing_legs`]) at finite body cost.
+    fn stand(&mut self, t: LatticeState, o: &FootOffsets) -> Stand {
         let key = (t.i, t.j, t.theta, *o);
-        if let Some(&ok) = self.standable.get(&key) {
-            return ok;
+        if let Some(&stand) = self.standable.get(&key) {
+            return stand;
         }
-        let ok = self.feet_of(t, o).is_some_and(|feet| {
-            self.standing_legs(t, &feet).is_some_and(|legs| {
-                self.maps.body_cost(&self.lattice.pose(t), &feet.pos, &legs).is_finite()
-            })
-        });
-        self.standable.insert(key, ok);
-        ok
+        let stand =
+            self.feet_of(t, o).map_or(Stand::No, |feet| match self.standing_legs(t, &feet) {
+                Some((legs, swept))
+                    if self.maps.body_cost(&self.lattice.pose(t), &feet.pos, &legs).is_finite() =>
+                {
+                    if swept {
+                        Stand::SweptClear
+                    } else {
+                        Stand::Stands
+                    }
+                }
+                _ => Stand::No,
+            });
+        self.standable.insert(key, stand);
+        stand
     }
 
     /// Whether the robot at `s` (offsets `o`) can roll the wheel pair of move `m` its
-    /// whole way: the footprint with that foot at every cell of the way, the last one
-    /// included, can stand ([`Self::target_ok`], memoised): the generator moves the foot
-    /// through the same cells, the base standing by the shared rule at each
-    /// (`expand`'s wheel move). Checking the two ends alone let a knee dip below the
-    /// legs' clearance on the way.
+    /// whole way, as the generator moves it (`expand`'s wheel move: a keyframe per cell of
+    /// the way, the base stood by the shared rule at each, every point 1 cm apart between
+    /// two checked):
+    /// - the footprint with that foot at every cell of the way, the last one included,
+    ///   can stand ([`Self::target_ok`], memoised);
+    /// - between two cells whose postures both clear the swept leg terrain
+    ///   ([`Stand::SweptClear`]) no leg point comes within the legs' clearance of the
+    ///   terrain (the argument of `feasibility` for neighbouring lattice poses: a leg point
+    ///   moves less than the sweep's two cells between them);
+    /// - between any other two, near an edge, the generator's own expansion of that cell's
+    ///   move decides ([`expand::wheel_move_motion`], memoised by pose, footprint, leg and
+    ///   new offset, so moves through the same cells share it).
+    ///
+    /// Checking the two ends alone let a knee dip below the legs' clearance on the way;
+    /// checking the cells alone let a knee pass within it over a block's edge between two.
     fn wheel_move_feasible(&mut self, s: LatticeState, o: &FootOffsets, m: &FootMove) -> bool {
         // The end first: where it cannot stand, the way needs no look.
         if !self.target_ok(s, &m.to) {
@@ -949,10 +994,94 @@ impl<'c> HybridGraph<'c> {
         let (from, to) = (i32::from(o[k]), i32::from(m.to[k]));
         let mut via = *o;
         // The offsets strictly between the two ends.
-        (from.min(to) + 1..from.max(to)).all(|v| {
+        let cells_ok = (from.min(to) + 1..from.max(to)).all(|v| {
             via[k] = v as i8;
             self.target_ok(s, &via)
-        })
+        });
+        if !cells_ok {
+            return false;
+        }
+        let dir = (to - from).signum();
+        let mut a = *o;
+        let mut a_clear = self.stand(s, &a) == Stand::SweptClear;
+        while i32::from(a[k]) != to {
+            let mut b = a;
+            b[k] = (i32::from(a[k]) + dir) as i8;
+            let b_clear = self.stand(s, &b) == Stand::SweptClear;
+            let swept = a_clear && b_clear;
+            if !swept && !self.wheel_segment_ok(s, &a, m.leg, &b) {
+                return false;
+            }
+            (a, a_clear) = (b, b_clear);
+        }
+        true
+    }
+
+    /// The generator's one-cell wheel move of `leg`'s pair from footprint `a` to `b` at
+    /// `s`'s pose ([`expand::wheel_move_motion`] from the rule's standing posture on `a`),
+    /// with the CoM estimate and [`PLANNER_MARGIN_SLACK_M`] to spare; memoised.
+    fn wheel_segment_ok(
+        &mut self,
+        s: LatticeState,
+        a: &FootOffsets,
+        leg: Leg,
+        b: &FootOffsets,
+    ) -> bool {
+        let k = leg.index();
+        let key = ((s.i, s.j, s.theta, *a), k as u8, b[k]);
+        if let Some(&ok) = self.wheel_move_checks.get(&key) {
+            return ok;
+        }
+        let ok = self.wheel_segment_motion(s, a, leg, b).is_some();
+        self.wheel_move_checks.insert(key, ok);
+        ok
+    }
+
+    /// [`Self::wheel_segment_ok`] unmemoised; `Some` if the move holds.
+    fn wheel_segment_motion(
+        &self,
+        s: LatticeState,
+        a: &FootOffsets,
+        leg: Leg,
+        b: &FootOffsets,
+    ) -> Option<()> {
+        let (feet, after) = (self.feet_of(s, a)?, self.feet_of(s, b)?);
+        let pose = self.lattice.pose(s);
+        let (robot, maps, rule) = (&self.robot, self.maps, &self.config.motion.standing);
+        let world = Self::feet_xyz(&feet);
+        let (pre, _) =
+            rule.stand(robot, maps.leg_terrain(), world, [pose.x, pose.y], pose.theta).ok()?;
+        let mut model = EstimatedCom { robot };
+        let foot = after.pos[leg.index()];
+        expand::wheel_move_motion(robot, maps, &mut model, &self.config.motion, pre, leg, foot).ok()
+    }
+
+    /// Whether the generator expands the base shift from `s` (feet `feet`) to `t`: its
+    /// own expansion ([`expand::base_shift_motion`]: the base stood by the shared rule at
+    /// every cell of the way, every point between checked) from the rule's standing
+    /// posture, with the CoM estimate and [`PLANNER_MARGIN_SLACK_M`] to spare; memoised
+    /// by state and length. The end alone let a path through whose shift could not
+    /// stand on the way.
+    fn base_shift_feasible(&mut self, s: LatticeState, feet: &Feet, t: LatticeState) -> bool {
+        let key = (s.i, s.j, s.theta, s.footprint, t.i, t.j);
+        if let Some(&ok) = self.base_shift_checks.get(&key) {
+            return ok;
+        }
+        let ok = (|| {
+            let pose = self.lattice.pose(s);
+            let (robot, maps, rule) = (&self.robot, self.maps, &self.config.motion.standing);
+            let world = Self::feet_xyz(feet);
+            let (pre, _) =
+                rule.stand(robot, maps.leg_terrain(), world, [pose.x, pose.y], pose.theta).ok()?;
+            let after = self.feet(t)?;
+            let mut model = EstimatedCom { robot };
+            let to = self.lattice.pose(t);
+            expand::base_shift_motion(robot, maps, &mut model, &self.config.motion, pre, after, &to)
+                .ok()
+        })()
+        .is_some();
+        self.base_shift_checks.insert(key, ok);
+        ok
     }
 
     /// Interns `o` and returns the state at `(i, j, θ)` with that footprint.
@@ -1743,7 +1872,7 @@ impl<'c> HybridGraph<'c> {
         let res = self.lattice.resolution;
         let (hx, hy) = self.heading(s.theta);
         let p = self.lattice.pose(s);
-        let Some(legs) = self.standing_legs(s, feet) else {
+        let Some((legs, _)) = self.standing_legs(s, feet) else {
             return;
         };
         // C_B,avg: the body cost at every cell-length of the shift, feet fixed in the world.
@@ -1768,6 +1897,9 @@ impl<'c> HybridGraph<'c> {
         let Some(t) = self.with_footprint(t, o2) else {
             return;
         };
+        if !self.base_shift_feasible(s, feet, t) {
+            return;
+        }
         let cost = (self.config.step_cost_factor * base_shift_cost(&self.config, length, cb_avg))
             .max(moved);
         self.stats.base_shifts += 1;

@@ -876,6 +876,39 @@ impl<'a> Expander<'a> {
     }
 }
 
+impl Expander<'_> {
+    /// A planned base shift to `to`, the feet at `feet` (x, y on the ground): through
+    /// every cell of the way, the base stood by the shared rule at each, as the planner
+    /// checks it ([`base_shift_motion`]). The planner's shift ends on a lattice cell, so
+    /// its feet stand up to half a cell from where they were: the shift takes its
+    /// footprint (the wheels roll that far), so both agree on every later reach.
+    fn expand_base_shift(
+        &mut self,
+        kind: PathKind,
+        feet: [[f64; 2]; 4],
+        to: &Pose2,
+    ) -> Result<(), MotionError> {
+        let mut on_ground = self.cur.feet;
+        for (f, p) in on_ground.iter_mut().zip(feet) {
+            *f = [p[0], p[1], self.ground(p[0], p[1])?];
+        }
+        let (from, to_xy) = (self.xy(), [to.x, to.y]);
+        let res = self.maps.heights().resolution();
+        let dist = (to_xy[0] - from[0]).hypot(to_xy[1] - from[1]);
+        let n = (dist / res).ceil().max(1.0) as usize;
+        let mut seq = Vec::with_capacity(n);
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            let xy = [from[0] + (to_xy[0] - from[0]) * t, from[1] + (to_xy[1] - from[1]) * t];
+            let p = self.standing_fallback(on_ground, xy, to.theta).map_err(|reason| {
+                MotionError::Manoeuvre { index: self.index, kind: kind_name(kind), reason }
+            })?;
+            seq.push((Phase::PlannedBaseShift, None, p));
+        }
+        self.push(kind, &seq)
+    }
+}
+
 /// Which step candidates the expansion tries (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StepSearch {
@@ -957,6 +990,50 @@ pub fn step_motion(
         StepSearch::Planner,
         heights,
     )
+}
+
+/// The planner's check of a wheel move (`locomotion::hybrid`): the generator's own
+/// expansion of the move of `leg`'s pair to `foot` (x, y) from posture `pre` (the shared
+/// rule's standing posture, [`StandingRule::stand`]), with the CoM of `model` and the
+/// margins of `options`: a keyframe per cell of the way, each stood by the rule, and every
+/// point 1 cm apart between them. The rule's postures at the cells alone let a knee pass
+/// within the legs' clearance of a block's edge between two of them.
+///
+/// # Errors
+/// The expansion's [`MotionError::Manoeuvre`] (or [`MotionError::UnknownTerrain`]).
+pub fn wheel_move_motion(
+    robot: &RobotDescription,
+    maps: &CostMaps,
+    model: &mut dyn CenterOfMassModel,
+    options: &MotionOptions,
+    pre: Posture,
+    leg: Leg,
+    foot: [f64; 2],
+) -> Result<(), MotionError> {
+    Expander::at(robot, maps, model, options, pre).expand_wheel_move(
+        PathKind::FootForward,
+        leg,
+        foot,
+    )
+}
+
+/// The planner's check of a planned base shift (`locomotion::hybrid`): the generator's
+/// own expansion of the shift from posture `pre` (the shared rule's standing posture) to
+/// pose `to` over feet `feet` (x, y: the footprint at the shift's end), with the CoM of
+/// `model` and the margins of `options`.
+///
+/// # Errors
+/// The expansion's [`MotionError::Manoeuvre`] (or [`MotionError::UnknownTerrain`]).
+pub fn base_shift_motion(
+    robot: &RobotDescription,
+    maps: &CostMaps,
+    model: &mut dyn CenterOfMassModel,
+    options: &MotionOptions,
+    pre: Posture,
+    feet: [[f64; 2]; 4],
+    to: &Pose2,
+) -> Result<(), MotionError> {
+    Expander::at(robot, maps, model, options, pre).expand_base_shift(PathKind::BaseShift, feet, to)
 }
 
 /// What a step candidate's alignment depends on: leg height, wheel and roll fractions.
@@ -1133,28 +1210,8 @@ pub fn expand_path(
                         steps += 1;
                     }
                     (PathKind::BaseShift, _) => {
-                        // The planner's shift ends on a lattice cell, so its feet stand up
-                        // to half a cell from where they were: take its footprint (the
-                        // wheels roll that far), so both agree on every later reach.
-                        let mut feet = ex.cur.feet;
-                        for (f, p) in feet.iter_mut().zip(el.feet) {
-                            *f = [p[0], p[1], ex.ground(p[0], p[1])?];
-                        }
-                        // Through every cell of the way by the standing rule, as the
-                        // planner checked it (legs reach and clear the terrain).
-                        let (from, to) = (ex.xy(), [el.pose.x, el.pose.y]);
-                        let res = maps.heights().resolution();
-                        let dist = (to[0] - from[0]).hypot(to[1] - from[1]);
-                        let n = (dist / res).ceil().max(1.0) as usize;
-                        let mut seq = Vec::with_capacity(n);
-                        for k in 1..=n {
-                            let t = k as f64 / n as f64;
-                            let xy =
-                                [from[0] + (to[0] - from[0]) * t, from[1] + (to[1] - from[1]) * t];
-                            let p = ex.standing_fallback(feet, xy, el.pose.theta).map_err(bad)?;
-                            seq.push((Phase::PlannedBaseShift, None, p));
-                        }
-                        ex.push(el.kind, &seq)?;
+                        ex.settle(el.kind, &path[k - 1].pose)?;
+                        ex.expand_base_shift(el.kind, el.feet, &el.pose)?;
                     }
                     (_, Some(leg)) => {
                         ex.settle(el.kind, &path[k - 1].pose)?;

@@ -188,6 +188,21 @@ impl StandingRule {
         xy: [f64; 2],
         yaw: f64,
     ) -> Result<(Posture, f64), PostureError> {
+        self.stand_legs(robot, terrain, feet, xy, yaw).map(|(p, h, _)| (p, h))
+    }
+
+    /// [`Self::stand`] with the posture's solved legs.
+    ///
+    /// # Errors
+    /// As [`Self::stand`].
+    pub fn stand_legs(
+        &self,
+        robot: &RobotDescription,
+        terrain: &HeightMap,
+        feet: [[f64; 3]; 4],
+        xy: [f64; 2],
+        yaw: f64,
+    ) -> Result<(Posture, f64, SolvedLegs), PostureError> {
         let pitch = self.pitch(&feet, yaw);
         let ground = feet.map(|f| f[2]);
         let frame = BaseFrame::new([0.0, pitch, yaw]);
@@ -200,9 +215,9 @@ impl StandingRule {
             }
             let p = level_posture_in(robot, feet, [true; 4], xy, &frame, h, ground);
             match solve_chains_in(robot, &frame, &p, self.reach_margin_m)
-                .and_then(|legs| self.legs_clear(robot, terrain, &legs))
+                .and_then(|legs| self.legs_clear(robot, terrain, &legs).map(|()| legs))
             {
-                Ok(()) => return Ok((p, h)),
+                Ok(legs) => return Ok((p, h, legs)),
                 Err(e) => last = Some(e),
             }
         }
