@@ -966,12 +966,13 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                     opts.repeats
                 );
                 say!(
-                    "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12} {:>10} {:>10}",
+                    "{:<13} {:<5} {:>10} {:>12} {:>10} {:>7} {:>10} {:>10} {:>12} {:>10} {:>10}",
                     "algo",
                     "nbhd",
                     "optimum",
                     "first",
                     "over opt",
+                    "bound",
                     "cost@1s",
                     "cost@10s",
                     "to optimum",
@@ -980,12 +981,13 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 );
                 for r in &report.rows {
                     say!(
-                        "{:<8} {:<5} {:>10} {:>12} {:>10} {:>10} {:>10} {:>12} {:>10} {:>10}",
+                        "{:<13} {:<5} {:>10} {:>12} {:>10} {:>7} {:>10} {:>10} {:>12} {:>10} {:>10}",
                         r.algorithm,
                         r.neighbourhood,
                         c(r.optimum),
                         ms(r.first_solution_s),
                         pct(r.first_over_optimum_pct),
+                        r.first_bound.map_or("-".to_owned(), |b| format!("{b:.2}")),
                         c(r.cost_at_1s),
                         c(r.cost_at_10s),
                         ms(r.time_to_optimum_s),

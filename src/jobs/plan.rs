@@ -276,7 +276,8 @@ pub struct MapInfo {
 pub struct PlanSummary {
     /// Scenario name.
     pub scenario: String,
-    /// `astar` or `arastar`.
+    /// `astar`, `arastar` (the paper's schedule alone) or `arastar+probe` (ARA* as
+    /// `plan` and `run` search: the greedy probe first, `SearchParams::probe_epsilon`).
     pub algorithm: &'static str,
     /// Every solution in the order found (costs never increase).
     pub solutions: Vec<SolutionSummary>,
@@ -799,6 +800,9 @@ pub struct BenchRow {
     pub first_cost: Option<f64>,
     /// Its cost over the optimum, % (`(first / optimum − 1) · 100`).
     pub first_over_optimum_pct: Option<f64>,
+    /// The bound ARA* certifies for it (`Solution::suboptimality_bound`, ε′ ≤ ε): its
+    /// cost is at most this times the optimum.
+    pub first_bound: Option<f64>,
     /// Best cost found within 1 s.
     pub cost_at_1s: Option<f64>,
     /// Best cost found within 10 s.
@@ -872,8 +876,10 @@ pub struct BenchReport {
 }
 
 /// Benchmarks A* (16-neighbourhood) and ARA* (20-neighbourhood, ε from 3) on
-/// `scenario`. The optimum of each neighbourhood comes from an A* run with
-/// `optimum_time_limit_s`; for the A* row that run is the measurement itself.
+/// `scenario`, ARA* twice: the paper's schedule alone, and as `plan` runs it, after the
+/// greedy probe (the scenario's `arastar_probe_epsilon`). The optimum of each
+/// neighbourhood comes from an A* run with `optimum_time_limit_s`; for the A* row that
+/// run is the measurement itself.
 ///
 /// # Errors
 /// As [`run`]'s set-up errors, and invalid options.
@@ -890,8 +896,11 @@ pub fn bench(
     let file = || scenario.path.clone();
     let prep = prepare(scenario, robot, opts.k12, None, None)?;
     let k12 = prep.params.k12;
-    let run_one =
-        |algorithm, n, limit| -> Result<(SearchResult<LatticeState>, f64), PlanJobError> {
+    let probe = prep.params.arastar_probe_epsilon;
+    let run_one = |algorithm, n, limit, probe_epsilon| -> Result<
+        (SearchResult<LatticeState>, f64),
+        PlanJobError,
+    > {
             let mut g = prep
                 .graph(robot, n, k12)
                 .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
@@ -900,6 +909,7 @@ pub fn bench(
                 initial_epsilon: prep.params.arastar_initial_epsilon,
                 epsilon_decay: prep.params.arastar_epsilon_decay,
                 time_limit: Some(limit),
+                probe_epsilon,
                 ..SearchParams::default()
             };
             search(&mut g, prep.start, algorithm, &p, None)
@@ -908,15 +918,25 @@ pub fn bench(
         };
     // The repeats alternate the three searches, so slow phases of a noisy machine spread
     // over all of them.
-    let (mut astar_runs, mut ara_runs) = (Vec::new(), Vec::new());
+    let (mut astar_runs, mut ara_runs, mut probe_runs) = (Vec::new(), Vec::new(), Vec::new());
+    let probe_epsilon = (probe > prep.params.arastar_initial_epsilon).then_some(probe);
     for _ in 0..opts.repeats {
-        let (astar16, setup16) = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit)?;
+        let (astar16, setup16) = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit, None)?;
         astar_runs.push(row("astar", "n16", &astar16, optimum_of(&astar16), &astar16, setup16));
-        let (astar20, _) = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit)?;
-        let (ara, setup20) = run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit)?;
-        ara_runs.push(row("arastar", "n20", &ara, optimum_of(&astar20), &astar20, setup20));
+        let (astar20, _) = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit, None)?;
+        let optimum20 = optimum_of(&astar20);
+        let (ara, setup20) = run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit, None)?;
+        ara_runs.push(row("arastar", "n20", &ara, optimum20, &astar20, setup20));
+        if probe_epsilon.is_some() {
+            let (ara, setup) =
+                run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit, probe_epsilon)?;
+            probe_runs.push(row("arastar+probe", "n20", &ara, optimum20, &astar20, setup));
+        }
     }
-    let rows = [astar_runs, ara_runs].into_iter().filter_map(BenchRow::median_of).collect();
+    let rows = [astar_runs, ara_runs, probe_runs]
+        .into_iter()
+        .filter_map(BenchRow::median_of)
+        .collect();
     Ok(BenchReport { scenario: scenario.name.clone(), setup_time_s: prep.setup_time_s, rows })
 }
 
@@ -950,6 +970,7 @@ fn row(
         first_solution_s: first.map(|f| f.0),
         first_cost: first.map(|f| f.1),
         first_over_optimum_pct: first.zip(optimum).map(|(f, o)| (f.1 / o - 1.0) * 100.0),
+        first_bound: r.solutions.first().map(|s| s.suboptimality_bound),
         cost_at_1s: at(1.0),
         cost_at_10s: at(10.0),
         time_to_optimum_s: time_to_optimum,
@@ -975,6 +996,7 @@ mod tests {
             first_solution_s: Some(first),
             first_cost: Some(80.0),
             first_over_optimum_pct: Some(2.5),
+            first_bound: Some(1.6),
             cost_at_1s: at_1s,
             cost_at_10s: Some(79.0),
             time_to_optimum_s: to_optimum,
