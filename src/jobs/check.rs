@@ -8,7 +8,7 @@
 //! cargo-nextest's `--partition count:K/N`, so a CI matrix or a cluster job array of `N`
 //! jobs runs every file exactly once.
 //!
-//! [`run`] hands whole scenarios to `jobs` worker threads: each takes the next index from
+//! [`run()`] hands whole scenarios to `jobs` worker threads: each takes the next index from
 //! an atomic counter, loads the file and runs it (the worker builds its own
 //! `Simulation`, maps and planner; nothing is shared but the options), and sends the row
 //! back over a channel. Rows are reported as they finish (for progress) and returned in

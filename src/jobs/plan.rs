@@ -897,25 +897,26 @@ pub fn bench(
     let prep = prepare(scenario, robot, opts.k12, None, None)?;
     let k12 = prep.params.k12;
     let probe = prep.params.arastar_probe_epsilon;
-    let run_one = |algorithm, n, limit, probe_epsilon| -> Result<
-        (SearchResult<LatticeState>, f64),
-        PlanJobError,
-    > {
-            let mut g = prep
-                .graph(robot, n, k12)
-                .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
-            let setup = g.heuristic_setup_time().as_secs_f64();
-            let p = SearchParams {
-                initial_epsilon: prep.params.arastar_initial_epsilon,
-                epsilon_decay: prep.params.arastar_epsilon_decay,
-                time_limit: Some(limit),
-                probe_epsilon,
-                ..SearchParams::default()
-            };
-            search(&mut g, prep.start, algorithm, &p, None)
-                .map(|r| (r, setup))
-                .map_err(|source| PlanJobError::Search { scenario: file(), source })
+    let run_one = |algorithm,
+                   n,
+                   limit,
+                   probe_epsilon|
+     -> Result<(SearchResult<LatticeState>, f64), PlanJobError> {
+        let mut g = prep
+            .graph(robot, n, k12)
+            .map_err(|source| PlanJobError::Lattice { scenario: file(), source })?;
+        let setup = g.heuristic_setup_time().as_secs_f64();
+        let p = SearchParams {
+            initial_epsilon: prep.params.arastar_initial_epsilon,
+            epsilon_decay: prep.params.arastar_epsilon_decay,
+            time_limit: Some(limit),
+            probe_epsilon,
+            ..SearchParams::default()
         };
+        search(&mut g, prep.start, algorithm, &p, None)
+            .map(|r| (r, setup))
+            .map_err(|source| PlanJobError::Search { scenario: file(), source })
+    };
     // The repeats alternate the three searches, so slow phases of a noisy machine spread
     // over all of them.
     let (mut astar_runs, mut ara_runs, mut probe_runs) = (Vec::new(), Vec::new(), Vec::new());
@@ -933,10 +934,8 @@ pub fn bench(
             probe_runs.push(row("arastar+probe", "n20", &ara, optimum20, &astar20, setup));
         }
     }
-    let rows = [astar_runs, ara_runs, probe_runs]
-        .into_iter()
-        .filter_map(BenchRow::median_of)
-        .collect();
+    let rows =
+        [astar_runs, ara_runs, probe_runs].into_iter().filter_map(BenchRow::median_of).collect();
     Ok(BenchReport { scenario: scenario.name.clone(), setup_time_s: prep.setup_time_s, rows })
 }
 

@@ -16,7 +16,7 @@
 //! depends on the foot heading (`Params::foot_model = wheel_pair`) prices poses with
 //! straight wheels, while a drive steers every pair along its velocity: such a move or
 //! turn also needs both end poses' feet to fit with the pairs steered so
-//! ([`PoseCostSource::steered_fit`]); the paper's model always fits. Only the two end
+//! ([`PoseCostSource::steered_fit_mask`]); the paper's model always fits. Only the two end
 //! poses of a move are checked: a two-cell move could hop a one-cell-wide untraversable
 //! line, which the cost client never produces (infinite foot costs are dilated by
 //! r_F = 0.12 m, about five cells).

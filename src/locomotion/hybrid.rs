@@ -54,7 +54,7 @@
 //!   may (`HybridGraph::step_supported`; with `step_model = "stairs"` the generator's
 //!   lift keyframe through its roll and base-shift alignments). That is
 //!   the cheap filter; a step that passes it must then pass the generator's own check
-//!   (`motion::expand::step_motion`: roll, wheel to centre, base shift, lift, swing,
+//!   (`motion::expand::ManoeuvreCheck::step`: roll, wheel to centre, base shift, lift, swing,
 //!   place and back, every centimetre, with the CoM estimate and 3 mm of margin to
 //!   spare), so a planned step is one the generator expands.
 //! - *Which footholds count as a step.* A step must carry the foot *over* untraversable
@@ -153,8 +153,8 @@ use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::{Pose2, norm2};
 use crate::motion::CenterOfMassModel;
-use crate::motion::expand::{self, MotionOptions};
-use crate::motion::kinematics::{hips_in_world, solve_chains};
+use crate::motion::expand::{ManoeuvreCheck, MotionError, MotionOptions};
+use crate::motion::kinematics::{Posture, hips_in_world, solve_chains};
 use crate::motion::roll::roll_for_lateral_com;
 use crate::motion::standing::{EstimatedCom, StepStance, com_estimate, level_posture};
 use crate::params::{Params, StepModel};
@@ -280,7 +280,7 @@ pub struct HybridConfig {
     /// The motion generator's constants: the leg-height rule for standing manoeuvres
     /// (reach and leg clearance, Sec. VI-B), the driving leg height, the base circles'
     /// radius, the wheel-to-centre move and gap of a step; with them steps are checked
-    /// ([`expand::step_motion`]), whose margin is the generator's plus
+    /// ([`ManoeuvreCheck::step`]), whose margin is the generator's plus
     /// [`PLANNER_MARGIN_SLACK_M`].
     pub motion: MotionOptions,
 }
@@ -897,7 +897,7 @@ impl<'c> HybridGraph<'c> {
     ///   [`StandingRule::step_heights`]; the first, tallest height is the stance),
     /// - the CoM estimate lies in the support triangle ([`Self::step_supported`]), a cheap
     ///   filter before
-    /// - the generator's own check ([`expand::step_motion`]) from the standing posture of
+    /// - the generator's own check ([`ManoeuvreCheck::step`]) from the standing posture of
     ///   the shared rule, at every sample, with the CoM estimate ([`EstimatedCom`]) and
     ///   [`PLANNER_MARGIN_SLACK_M`] to spare.
     fn step_feasible(&self, s: LatticeState, feet: &Feet, leg: usize, post: [f64; 3]) -> bool {
@@ -921,14 +921,31 @@ impl<'c> HybridGraph<'c> {
         if !self.step_supported(s, feet, leg, post, first) {
             return false;
         }
-        let Ok((pre, _)) = rule.stand(robot, maps.leg_terrain(), pre_feet, xy, pose.theta) else {
+        let heights = std::iter::once(first).chain(heights);
+        self.generator_check(s, feet, |check, pre| check.step(pre, Leg::ALL[leg], post, heights))
+    }
+
+    /// Runs one of the generator's own checks (`check`, [`ManoeuvreCheck`]) from
+    /// the shared rule's standing posture at `s`'s pose on feet `feet`, with the CoM
+    /// estimate and the planner's margins; whether it holds.
+    fn generator_check(
+        &self,
+        s: LatticeState,
+        feet: &Feet,
+        check: impl FnOnce(&mut ManoeuvreCheck<'_>, Posture) -> Result<(), MotionError>,
+    ) -> bool {
+        let pose = self.lattice.pose(s);
+        let robot = &self.robot;
+        let rule = &self.config.motion.standing;
+        let world = Self::feet_xyz(feet);
+        let xy = [pose.x, pose.y];
+        let Ok((pre, _)) = rule.stand(robot, self.maps.leg_terrain(), world, xy, pose.theta) else {
             return false;
         };
         let mut model = EstimatedCom { robot };
-        let heights = std::iter::once(first).chain(heights);
         let options = &self.config.motion;
-        expand::step_motion(robot, maps, &mut model, options, pre, Leg::ALL[leg], post, heights)
-            .is_ok()
+        let mut c = ManoeuvreCheck { robot, maps: self.maps, model: &mut model, options };
+        check(&mut c, pre).is_ok()
     }
 
     /// Whether state `t` (footprint offsets `o`) may be entered; its body cost for
@@ -980,7 +997,7 @@ impl<'c> HybridGraph<'c> {
     ///   terrain (the argument of `feasibility` for neighbouring lattice poses: a leg point
     ///   moves less than the sweep's two cells between them);
     /// - between any other two, near an edge, the generator's own expansion of that cell's
-    ///   move decides ([`expand::wheel_move_motion`], memoised by pose, footprint, leg and
+    ///   move decides ([`ManoeuvreCheck::wheel_move`], memoised by pose, footprint, leg and
     ///   new offset, so moves through the same cells share it).
     ///
     /// Checking the two ends alone let a knee dip below the legs' clearance on the way;
@@ -1018,7 +1035,7 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// The generator's one-cell wheel move of `leg`'s pair from footprint `a` to `b` at
-    /// `s`'s pose ([`expand::wheel_move_motion`] from the rule's standing posture on `a`),
+    /// `s`'s pose ([`ManoeuvreCheck::wheel_move`] from the rule's standing posture on `a`),
     /// with the CoM estimate and [`PLANNER_MARGIN_SLACK_M`] to spare; memoised.
     fn wheel_segment_ok(
         &mut self,
@@ -1032,32 +1049,28 @@ impl<'c> HybridGraph<'c> {
         if let Some(&ok) = self.wheel_move_checks.get(&key) {
             return ok;
         }
-        let ok = self.wheel_segment_motion(s, a, leg, b).is_some();
+        let ok = self.wheel_segment_motion(s, a, leg, b);
         self.wheel_move_checks.insert(key, ok);
         ok
     }
 
-    /// [`Self::wheel_segment_ok`] unmemoised; `Some` if the move holds.
+    /// [`Self::wheel_segment_ok`] unmemoised.
     fn wheel_segment_motion(
         &self,
         s: LatticeState,
         a: &FootOffsets,
         leg: Leg,
         b: &FootOffsets,
-    ) -> Option<()> {
-        let (feet, after) = (self.feet_of(s, a)?, self.feet_of(s, b)?);
-        let pose = self.lattice.pose(s);
-        let (robot, maps, rule) = (&self.robot, self.maps, &self.config.motion.standing);
-        let world = Self::feet_xyz(&feet);
-        let (pre, _) =
-            rule.stand(robot, maps.leg_terrain(), world, [pose.x, pose.y], pose.theta).ok()?;
-        let mut model = EstimatedCom { robot };
+    ) -> bool {
+        let (Some(feet), Some(after)) = (self.feet_of(s, a), self.feet_of(s, b)) else {
+            return false;
+        };
         let foot = after.pos[leg.index()];
-        expand::wheel_move_motion(robot, maps, &mut model, &self.config.motion, pre, leg, foot).ok()
+        self.generator_check(s, &feet, |check, pre| check.wheel_move(pre, leg, foot))
     }
 
     /// Whether the generator expands the base shift from `s` (feet `feet`) to `t`: its
-    /// own expansion ([`expand::base_shift_motion`]: the base stood by the shared rule at
+    /// own expansion ([`ManoeuvreCheck::base_shift`]: the base stood by the shared rule at
     /// every cell of the way, every point between checked) from the rule's standing
     /// posture, with the CoM estimate and [`PLANNER_MARGIN_SLACK_M`] to spare; memoised
     /// by state and length. The end alone let a path through whose shift could not
@@ -1067,19 +1080,10 @@ impl<'c> HybridGraph<'c> {
         if let Some(&ok) = self.base_shift_checks.get(&key) {
             return ok;
         }
-        let ok = (|| {
-            let pose = self.lattice.pose(s);
-            let (robot, maps, rule) = (&self.robot, self.maps, &self.config.motion.standing);
-            let world = Self::feet_xyz(feet);
-            let (pre, _) =
-                rule.stand(robot, maps.leg_terrain(), world, [pose.x, pose.y], pose.theta).ok()?;
-            let after = self.feet(t)?;
-            let mut model = EstimatedCom { robot };
-            let to = self.lattice.pose(t);
-            expand::base_shift_motion(robot, maps, &mut model, &self.config.motion, pre, after, &to)
-                .ok()
-        })()
-        .is_some();
+        let to = self.lattice.pose(t);
+        let ok = self.feet(t).is_some_and(|after| {
+            self.generator_check(s, feet, |check, pre| check.base_shift(pre, after, &to))
+        });
         self.base_shift_checks.insert(key, ok);
         ok
     }
@@ -1512,7 +1516,7 @@ impl<'c> HybridGraph<'c> {
 
     /// The support pre-check of a step of `leg` from state `s` (feet `feet`) to `post`
     /// at leg height `height` (the first the standing rule gives), run before the
-    /// generator's own check ([`expand::step_motion`]), which decides. With
+    /// generator's own check ([`ManoeuvreCheck::step`]), which decides. With
     /// [`StepModel::Paper`], [`Self::unaligned_support`]. With [`StepModel::Stairs`],
     /// the generator's lift keyframe followed through its alignments (Sec. VI-A), where
     /// most failing steps fail:

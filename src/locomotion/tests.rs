@@ -539,9 +539,13 @@ mod hybrid {
                 }
                 let to = g.feet(u).expect("feet")[leg.index()];
                 let mut model = crate::motion::standing::EstimatedCom { robot: &robot };
-                let r = crate::motion::expand::wheel_move_motion(
-                    &robot, &maps, &mut model, &motion, pre, leg, to,
-                );
+                let mut check = crate::motion::expand::ManoeuvreCheck {
+                    robot: &robot,
+                    maps: &maps,
+                    model: &mut model,
+                    options: &motion,
+                };
+                let r = check.wheel_move(pre, leg, to);
                 assert!(r.is_ok(), "{o:?}: {leg:?} to {:?}: {r:?}", g.offsets(u));
                 checked += 1;
             }

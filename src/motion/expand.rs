@@ -48,7 +48,7 @@
 //! holds is taken; otherwise [`MotionError::Step`] names the step, the leg and the best
 //! margin reached.
 //!
-//! **The planner runs the same check** ([`step_motion`], [`StepSearch::Planner`]): the
+//! **The planner runs the same check** ([`ManoeuvreCheck::step`], [`StepSearch::Planner`]): the
 //! first two heights with full wheel alignment and every roll and shift fraction, a
 //! subset of the generator's candidates, from the shared rule's standing posture at the
 //! planned pose ([`StandingRule::stand`]). The generator settles into that posture before
@@ -831,7 +831,7 @@ impl<'a> Expander<'a> {
     /// Moves the base, all feet down, to the shared rule's standing posture over the
     /// current feet at `pose` ([`StandingRule::stand`]) if it is not there: every step and
     /// wheel move starts from that posture, the one the planner checks it from
-    /// ([`step_motion`], for steps), whatever the manoeuvre before left (a roll-back
+    /// ([`ManoeuvreCheck::step`], for steps), whatever the manoeuvre before left (a roll-back
     /// at another leg height, a base re-centred on its feet).
     fn settle(&mut self, kind: PathKind, pose: &Pose2) -> Result<(), MotionError> {
         let p = self.standing_fallback(self.cur.feet, [pose.x, pose.y], pose.theta).map_err(
@@ -879,7 +879,7 @@ impl<'a> Expander<'a> {
 impl Expander<'_> {
     /// A planned base shift to `to`, the feet at `feet` (x, y on the ground): through
     /// every cell of the way, the base stood by the shared rule at each, as the planner
-    /// checks it ([`base_shift_motion`]). The planner's shift ends on a lattice cell, so
+    /// checks it ([`ManoeuvreCheck::base_shift`]). The planner's shift ends on a lattice cell, so
     /// its feet stand up to half a cell from where they were: the shift takes its
     /// footprint (the wheels roll that far), so both agree on every later reach.
     fn expand_base_shift(
@@ -964,76 +964,73 @@ const PLANNER_ALIGNMENTS: [(f64, f64); 9] = [
     (0.5, 0.5),
 ];
 
-/// The planner's check of a step (`locomotion::hybrid`): whether the expansion finds a
-/// stable motion among the [`StepSearch::Planner`] candidates for a step of `leg` from
-/// posture `pre` (the shared rule's standing posture, [`StandingRule::stand`]) to
-/// `post_foot`, with the CoM of `model` and margins of `options`. `heights` are the
-/// shared rule's step heights for this step ([`StandingRule::step_heights`], which the
-/// planner has begun to draw on): the generator computes the same from `pre`.
-///
-/// # Errors
-/// The expansion's [`MotionError::Step`] when no candidate holds.
-#[allow(clippy::too_many_arguments)]
-pub fn step_motion(
-    robot: &RobotDescription,
-    maps: &CostMaps,
-    model: &mut dyn CenterOfMassModel,
-    options: &MotionOptions,
-    pre: Posture,
-    leg: Leg,
-    post_foot: [f64; 3],
-    heights: impl Iterator<Item = f64>,
-) -> Result<(), MotionError> {
-    Expander::at(robot, maps, model, options, pre).expand_step_at(
-        leg,
-        post_foot,
-        StepSearch::Planner,
-        heights,
-    )
+/// The generator's own expansions as the planner asks them (`locomotion::hybrid`), each
+/// from posture `pre` (the shared rule's standing posture, [`StandingRule::stand`]) with
+/// the CoM of `model` and the margins of `options`: what a path's manoeuvre needs to pass
+/// here is what the generator later expands.
+pub struct ManoeuvreCheck<'a> {
+    /// The robot.
+    pub robot: &'a RobotDescription,
+    /// The maps the generator checks against.
+    pub maps: &'a CostMaps,
+    /// The CoM model (the planner's estimate).
+    pub model: &'a mut dyn CenterOfMassModel,
+    /// The generator's options, with the planner's margins.
+    pub options: &'a MotionOptions,
 }
 
-/// The planner's check of a wheel move (`locomotion::hybrid`): the generator's own
-/// expansion of the move of `leg`'s pair to `foot` (x, y) from posture `pre` (the shared
-/// rule's standing posture, [`StandingRule::stand`]), with the CoM of `model` and the
-/// margins of `options`: a keyframe per cell of the way, each stood by the rule, and every
-/// point 1 cm apart between them. The rule's postures at the cells alone let a knee pass
-/// within the legs' clearance of a block's edge between two of them.
-///
-/// # Errors
-/// The expansion's [`MotionError::Manoeuvre`] (or [`MotionError::UnknownTerrain`]).
-pub fn wheel_move_motion(
-    robot: &RobotDescription,
-    maps: &CostMaps,
-    model: &mut dyn CenterOfMassModel,
-    options: &MotionOptions,
-    pre: Posture,
-    leg: Leg,
-    foot: [f64; 2],
-) -> Result<(), MotionError> {
-    Expander::at(robot, maps, model, options, pre).expand_wheel_move(
-        PathKind::FootForward,
-        leg,
-        foot,
-    )
-}
+impl ManoeuvreCheck<'_> {
+    fn expander(&mut self, pre: Posture) -> Expander<'_> {
+        Expander::at(self.robot, self.maps, &mut *self.model, self.options, pre)
+    }
 
-/// The planner's check of a planned base shift (`locomotion::hybrid`): the generator's
-/// own expansion of the shift from posture `pre` (the shared rule's standing posture) to
-/// pose `to` over feet `feet` (x, y: the footprint at the shift's end), with the CoM of
-/// `model` and the margins of `options`.
-///
-/// # Errors
-/// The expansion's [`MotionError::Manoeuvre`] (or [`MotionError::UnknownTerrain`]).
-pub fn base_shift_motion(
-    robot: &RobotDescription,
-    maps: &CostMaps,
-    model: &mut dyn CenterOfMassModel,
-    options: &MotionOptions,
-    pre: Posture,
-    feet: [[f64; 2]; 4],
-    to: &Pose2,
-) -> Result<(), MotionError> {
-    Expander::at(robot, maps, model, options, pre).expand_base_shift(PathKind::BaseShift, feet, to)
+    /// A step: whether the expansion finds a stable motion among the
+    /// [`StepSearch::Planner`] candidates for a step of `leg` from `pre` to `post_foot`.
+    /// `heights` are the shared rule's step heights for this step
+    /// ([`StandingRule::step_heights`], which the planner has begun to draw on): the
+    /// generator computes the same from `pre`.
+    ///
+    /// # Errors
+    /// The expansion's [`MotionError::Step`] when no candidate holds.
+    pub fn step(
+        &mut self,
+        pre: Posture,
+        leg: Leg,
+        post_foot: [f64; 3],
+        heights: impl Iterator<Item = f64>,
+    ) -> Result<(), MotionError> {
+        self.expander(pre).expand_step_at(leg, post_foot, StepSearch::Planner, heights)
+    }
+
+    /// A wheel move of `leg`'s pair to `foot` (x, y): a keyframe per cell of the way, each
+    /// stood by the rule, and every point 1 cm apart between them. The rule's postures at
+    /// the cells alone let a knee pass within the legs' clearance of a block's edge
+    /// between two of them.
+    ///
+    /// # Errors
+    /// The expansion's [`MotionError::Manoeuvre`] (or [`MotionError::UnknownTerrain`]).
+    pub fn wheel_move(
+        &mut self,
+        pre: Posture,
+        leg: Leg,
+        foot: [f64; 2],
+    ) -> Result<(), MotionError> {
+        self.expander(pre).expand_wheel_move(PathKind::FootForward, leg, foot)
+    }
+
+    /// A planned base shift to pose `to` over feet `feet` (x, y: the footprint at the
+    /// shift's end): the base stood by the rule at every cell of the way.
+    ///
+    /// # Errors
+    /// The expansion's [`MotionError::Manoeuvre`] (or [`MotionError::UnknownTerrain`]).
+    pub fn base_shift(
+        &mut self,
+        pre: Posture,
+        feet: [[f64; 2]; 4],
+        to: &Pose2,
+    ) -> Result<(), MotionError> {
+        self.expander(pre).expand_base_shift(PathKind::BaseShift, feet, to)
+    }
 }
 
 /// What a step candidate's alignment depends on: leg height, wheel and roll fractions.
