@@ -86,6 +86,13 @@ pub struct ExecutorConfig {
     pub driving_leg_height_m: f64,
     /// Base pitch as a fraction of the slope (Sec. VI-B).
     pub pitch_fraction: f64,
+    /// Speed at which a drive run extends a leg whose wheels have lost the ground, m/s
+    /// (the drive's leg compliance, `drive`).
+    pub drive_extend_speed_mps: f64,
+    /// Speed at which a drive run gives the extension back while the wheels touch, m/s.
+    pub drive_release_speed_mps: f64,
+    /// Largest extension of a leg during a drive run, m.
+    pub max_drive_extension_m: f64,
     /// Contact confirmation of a placed foot.
     pub contact: ContactConfirmConfig,
     /// The path follower of drive runs.
@@ -123,6 +130,9 @@ impl ExecutorConfig {
             recover_angular_speed: 0.2,
             driving_leg_height_m: params.driving_leg_height_m,
             pitch_fraction: params.base_pitch_slope_fraction,
+            drive_extend_speed_mps: 0.05,
+            drive_release_speed_mps: 0.01,
+            max_drive_extension_m: 0.03,
             contact: ContactConfirmConfig::default(),
             follower,
             wheels: WheelKinematics::default(),

@@ -139,6 +139,8 @@ pub struct StepExecutor {
     cmd: Posture,
     /// Per-leg foot offsets (plan coordinates): landing corrections and extra lowering.
     foot_offset: [[f64; 3]; 4],
+    /// Per-leg extension of a drive run's legs whose wheels lost the ground, m (`drive`).
+    drive_extension: [f64; 4],
     /// Stabilising base correction (plan coordinates), m.
     correction: [f64; 2],
     /// The correction at the start of the segment that fades it out.
@@ -196,6 +198,7 @@ impl StepExecutor {
             mode: Mode::Finished,
             cmd,
             foot_offset: [[0.0; 3]; 4],
+            drive_extension: [0.0; 4],
             correction: [0.0; 2],
             fading: None,
             lift_offset: [0.0; 3],
@@ -285,6 +288,7 @@ impl StepExecutor {
                 match PathFollower::new(poses, self.config.follower.clone()) {
                     Ok(f) => {
                         self.foot_offset = [[0.0; 3]; 4];
+                        self.drive_extension = [0.0; 4];
                         self.correction = [0.0; 2];
                         self.fading = None;
                         self.mode = Mode::Drive { follower: Box::new(f), first: i, last };
