@@ -276,8 +276,7 @@ pub struct MapInfo {
 pub struct PlanSummary {
     /// Scenario name.
     pub scenario: String,
-    /// `astar`, `arastar` (the paper's schedule alone) or `arastar+probe` (ARA* as
-    /// `plan` and `run` search: the greedy probe first, `SearchParams::probe_epsilon`).
+    /// `astar` or `arastar`.
     pub algorithm: &'static str,
     /// Every solution in the order found (costs never increase).
     pub solutions: Vec<SolutionSummary>,
@@ -661,7 +660,7 @@ pub fn run(
     let probe = opts.probe_epsilon.unwrap_or(prep.params.arastar_probe_epsilon);
     let search_params = SearchParams {
         initial_epsilon: eps0,
-        probe_epsilon: (probe > eps0).then_some(probe),
+        probe_epsilon: probe_before(probe, eps0),
         schedule_max_expansions: opts.schedule_expansions,
         max_expansions: opts.max_expansions,
         final_epsilon: opts.final_epsilon.unwrap_or(1.0).min(eps0),
@@ -786,7 +785,8 @@ impl Default for BenchOptions {
 /// costs (with the scenario's k12), which is what the search optimises.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BenchRow {
-    /// `astar` or `arastar`.
+    /// `astar`, `arastar` (the paper's schedule alone) or `arastar+probe` (ARA* as
+    /// `plan` and `run` search: the greedy probe first, `SearchParams::probe_epsilon`).
     pub algorithm: &'static str,
     /// `n16` or `n20`.
     pub neighbourhood: &'static str,
@@ -896,7 +896,6 @@ pub fn bench(
     let file = || scenario.path.clone();
     let prep = prepare(scenario, robot, opts.k12, None, None)?;
     let k12 = prep.params.k12;
-    let probe = prep.params.arastar_probe_epsilon;
     let run_one = |algorithm,
                    n,
                    limit,
@@ -917,10 +916,11 @@ pub fn bench(
             .map(|r| (r, setup))
             .map_err(|source| PlanJobError::Search { scenario: file(), source })
     };
-    // The repeats alternate the three searches, so slow phases of a noisy machine spread
-    // over all of them.
+    // The repeats alternate the searches, so slow phases of a noisy machine spread over
+    // all of them.
     let (mut astar_runs, mut ara_runs, mut probe_runs) = (Vec::new(), Vec::new(), Vec::new());
-    let probe_epsilon = (probe > prep.params.arastar_initial_epsilon).then_some(probe);
+    let probe_epsilon =
+        probe_before(prep.params.arastar_probe_epsilon, prep.params.arastar_initial_epsilon);
     for _ in 0..opts.repeats {
         let (astar16, setup16) = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit, None)?;
         astar_runs.push(row("astar", "n16", &astar16, optimum_of(&astar16), &astar16, setup16));
@@ -937,6 +937,12 @@ pub fn bench(
     let rows =
         [astar_runs, ara_runs, probe_runs].into_iter().filter_map(BenchRow::median_of).collect();
     Ok(BenchReport { scenario: scenario.name.clone(), setup_time_s: prep.setup_time_s, rows })
+}
+
+/// ARA*'s probe at ε `probe` before a schedule from `initial_epsilon`
+/// (`SearchParams::probe_epsilon`): none unless it is greedier than the schedule.
+fn probe_before(probe: f64, initial_epsilon: f64) -> Option<f64> {
+    (probe > initial_epsilon).then_some(probe)
 }
 
 fn optimum_of(r: &SearchResult<LatticeState>) -> Option<f64> {

@@ -513,12 +513,25 @@ impl<'a> Expander<'a> {
 
     fn stand_up(&mut self, kind: PathKind) -> Result<(), MotionError> {
         let (feet, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
-        let p = self.standing_fallback(feet, xy, yaw).map_err(|reason| MotionError::Manoeuvre {
-            index: self.index,
+        let p = self.stand_for(kind, feet, xy, yaw)?;
+        self.push(kind, &[(Phase::StandUp, None, p)])
+    }
+
+    /// [`Self::standing_fallback`] within a manoeuvre of `kind`: its failure names the
+    /// manoeuvre.
+    fn stand_for(
+        &mut self,
+        kind: PathKind,
+        feet: [[f64; 3]; 4],
+        xy: [f64; 2],
+        yaw: f64,
+    ) -> Result<Posture, MotionError> {
+        let index = self.index;
+        self.standing_fallback(feet, xy, yaw).map_err(|reason| MotionError::Manoeuvre {
+            index,
             kind: kind_name(kind),
             reason,
-        })?;
-        self.push(kind, &[(Phase::StandUp, None, p)])
+        })
     }
 
     fn xy(&self) -> [f64; 2] {
@@ -829,14 +842,12 @@ impl<'a> Expander<'a> {
     }
 
     /// Moves the base, all feet down, to the shared rule's standing posture over the
-    /// current feet at `pose` ([`StandingRule::stand`]) if it is not there: every step and
-    /// wheel move starts from that posture, the one the planner checks it from
-    /// ([`ManoeuvreCheck::step`], for steps), whatever the manoeuvre before left (a roll-back
+    /// current feet at `pose` ([`StandingRule::stand`]) if it is not there: every step,
+    /// wheel move and planned base shift starts from that posture, the one the planner
+    /// checks it from ([`ManoeuvreCheck`]), whatever the manoeuvre before left (a roll-back
     /// at another leg height, a base re-centred on its feet).
     fn settle(&mut self, kind: PathKind, pose: &Pose2) -> Result<(), MotionError> {
-        let p = self.standing_fallback(self.cur.feet, [pose.x, pose.y], pose.theta).map_err(
-            |reason| MotionError::Manoeuvre { index: self.index, kind: kind_name(kind), reason },
-        )?;
+        let p = self.stand_for(kind, self.cur.feet, [pose.x, pose.y], pose.theta)?;
         if p != self.cur {
             self.push(kind, &[(Phase::StandUp, None, p)])?;
         }
@@ -867,16 +878,12 @@ impl<'a> Expander<'a> {
             let t = k as f64 / n as f64;
             let (x, y) = (from[0] + dx * t, from[1] + dy * t);
             feet[i] = [x, y, self.ground(x, y)?];
-            let p = self.standing_fallback(feet, xy, yaw).map_err(|reason| {
-                MotionError::Manoeuvre { index: self.index, kind: kind_name(kind), reason }
-            })?;
+            let p = self.stand_for(kind, feet, xy, yaw)?;
             seq.push((Phase::WheelMove, Some(leg), p));
         }
         self.push(kind, &seq)
     }
-}
 
-impl Expander<'_> {
     /// A planned base shift to `to`, the feet at `feet` (x, y on the ground): through
     /// every cell of the way, the base stood by the shared rule at each, as the planner
     /// checks it ([`ManoeuvreCheck::base_shift`]). The planner's shift ends on a lattice cell, so
@@ -900,9 +907,7 @@ impl Expander<'_> {
         for k in 1..=n {
             let t = k as f64 / n as f64;
             let xy = [from[0] + (to_xy[0] - from[0]) * t, from[1] + (to_xy[1] - from[1]) * t];
-            let p = self.standing_fallback(on_ground, xy, to.theta).map_err(|reason| {
-                MotionError::Manoeuvre { index: self.index, kind: kind_name(kind), reason }
-            })?;
+            let p = self.stand_for(kind, on_ground, xy, to.theta)?;
             seq.push((Phase::PlannedBaseShift, None, p));
         }
         self.push(kind, &seq)
@@ -1173,13 +1178,7 @@ pub fn expand_path(
                 }
                 let target = if standing {
                     let feet = ex.neutral_feet(&el.pose)?;
-                    ex.standing_fallback(feet, [el.pose.x, el.pose.y], el.pose.theta).map_err(
-                        |reason| MotionError::Manoeuvre {
-                            index: k,
-                            kind: kind_name(el.kind),
-                            reason,
-                        },
-                    )?
+                    ex.stand_for(el.kind, feet, [el.pose.x, el.pose.y], el.pose.theta)?
                 } else {
                     ex.driving(&el.pose)?
                 };
