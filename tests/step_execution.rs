@@ -263,7 +263,8 @@ fn platform_whole_mission_in_closed_loop() {
 
 #[test]
 fn step_down_whole_mission_in_closed_loop() {
-    // Stepping down from a 0.2 m platform. The generator once accepted the rear-right
+    // Stepping down from a 0.3 m platform (0.2 m until the descent shift: from 0.24 m
+    // every drop had no path). The generator once accepted the rear-right
     // step with 3 cm of estimated margin on three legs; the executor, which asks 5 cm
     // for the support legs' sag, could not shift the base that far over the planted
     // legs and aborted, and the return to the driving posture rolled the right rear foot

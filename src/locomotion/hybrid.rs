@@ -90,6 +90,17 @@
 //!   longitudinal shift is); a base shift like the others. Not offered on descents,
 //!   where it stretched the lower front legs to their reach limit (a planned descent
 //!   with it tipped over in closed loop).
+//! - *The descent shift* (both step models): a front foot close to an obstacle steps
+//!   down (its cheapest foothold lies lower than the foot by more than a wheel drives
+//!   down) and the front feet do not both stand ahead of neutral. The base shifts
+//!   forward past the front feet's neutral until that front hip stands over the middle
+//!   of the step, or the length nearest to it at which every leg stands on the way and
+//!   the foot can still step. It mirrors what a climb gets from the longitudinal shift
+//!   before its rear steps (the rear hip over the riser, the rear foot behind it): with
+//!   the hip over its foot, a front leg lifted over an edge folds past the knee's limit
+//!   at every height from which it still reaches a floor 0.24 m or more below, beyond the
+//!   edge's untraversable band, and every such drop had no path. A base shift like the
+//!   others (same cost, same heuristic terms), so the heuristic stays consistent.
 //! - *Flights longer than the robot* (four or more building-code steps) need the last
 //!   two and the partial foot to neutral: without them a rear foot short of a riser
 //!   could neither step nor roll up to it, and every reachable pose was searched
@@ -1190,6 +1201,50 @@ impl<'c> HybridGraph<'c> {
         candidates
     }
 
+    /// The descent shift of state `s` (offsets `o`, feet `feet`, criterion 1 per foot
+    /// `near`), in cells: where a front foot close to an obstacle steps down (its
+    /// cheapest foothold by the scan lies lower than the foot by more than a wheel drives
+    /// down, `max_foot_height_diff_m`) and the front feet do not both stand ahead of
+    /// neutral (the longitudinal shift's case), the base forward until that front hip
+    /// stands over the middle of its step, or the length nearest to it at which every
+    /// leg stands on the way ([`Self::shift_in_reach`]) and the front foot can still step
+    /// ([`Self::step_reaches`]). `None` when no front foot steps down, its hip is at or
+    /// past the middle already, or no length holds.
+    fn descent_shift(
+        &mut self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        near: [bool; 4],
+    ) -> Option<i8> {
+        if o[0] > 0 && o[1] > 0 {
+            return None;
+        }
+        let down = |f: usize| -> Option<i32> {
+            if !near[f] {
+                return None;
+            }
+            let c = *self.step_candidates(s, o, feet, f).first()?;
+            (c.3[2] < feet.h[f] - self.config.max_foot_height_diff_m).then_some(c.1)
+        };
+        // The hip over the middle of the step: the foot's offset plus half the step.
+        let (leg, target) = [0, 1]
+            .into_iter()
+            .filter_map(|f| down(f).map(|d| (f, i32::from(o[f]) + d / 2)))
+            .min_by_key(|&(_, t)| t)?;
+        if target <= 0 {
+            return None;
+        }
+        let longest = self.longest_shift_in_reach(s, feet, self.shift_room(o));
+        let mut lengths: Vec<i8> = (1..=longest).collect();
+        lengths.sort_by_key(|&l| (i32::from(l) - target).abs());
+        lengths.into_iter().find(|&l| {
+            self.shifted(s, o, l)
+                .and_then(|(t, o2)| Some((t, o2, self.feet_of(t, &o2)?)))
+                .is_some_and(|(t, o2, f)| self.step_reaches(t, &o2, &f, leg))
+        })
+    }
+
     /// The longest drive of a wheel pair from `p` in direction `dir`, at most `cells`
     /// cells, over drivable cells only: its length in cells and mean foot cost (both
     /// ends included); `None` if the cell under `p` is not drivable.
@@ -1328,6 +1383,11 @@ impl<'c> HybridGraph<'c> {
             if let Some(l) = self.rear_step_ready_shift(s, &o, near, l) {
                 self.push_base_shift(s, &o, &feet, l);
             }
+        }
+
+        // Descent shift (see the module docs): before a front foot steps down.
+        if let Some(l) = self.descent_shift(s, &o, &feet, near) {
+            self.push_base_shift(s, &o, &feet, l);
         }
 
         // Front wheel pairs forward, preparing a rear step: when a rear foot is close to
@@ -1802,16 +1862,13 @@ impl<'c> HybridGraph<'c> {
             let Some(feet) = self.feet_of(t, &o2) else {
                 return false;
             };
-            [2, 3]
-                .into_iter()
-                .filter(|&r| near[r])
-                .any(|r| self.rear_step_reaches(t, &o2, &feet, r))
+            [2, 3].into_iter().filter(|&r| near[r]).any(|r| self.step_reaches(t, &o2, &feet, r))
         })
     }
 
-    /// Whether rear leg `r` at state `t` (offsets `o`, feet `feet`) keeps every leg in
-    /// reach through a step to its cheapest foothold by the scan.
-    fn rear_step_reaches(&self, t: LatticeState, o: &FootOffsets, feet: &Feet, r: usize) -> bool {
+    /// Whether leg `r` at state `t` (offsets `o`, feet `feet`) keeps every leg in reach
+    /// through a step to its cheapest foothold by the scan.
+    fn step_reaches(&self, t: LatticeState, o: &FootOffsets, feet: &Feet, r: usize) -> bool {
         let Some(&(_, _, _, post)) = self.step_candidates(t, o, feet, r).first() else {
             return false;
         };

@@ -553,6 +553,52 @@ mod hybrid {
         assert!(checked > 0, "no wheel move offered");
     }
 
+    #[test]
+    fn steps_down_0_3_m_between_walls_with_the_descent_shift() {
+        // A 0.3 m platform ending at x = 1.0, between walls 1.3 m apart, the robot on it
+        // facing the edge. From hips over its feet no front step down holds: lifted over
+        // the edge the leg folds past the knee's limit at every height at which it still
+        // reaches the floor beyond the untraversable band. Every drop of 0.24-0.30 m
+        // answered "no path" after searching the whole map; with the descent shift (the
+        // hip over the middle of the step first) the robot steps down head-on.
+        let wall = |y: f64| Primitive::Box {
+            center: [1.5, y],
+            size: [6.0, 0.2],
+            height: 1.0,
+            yaw_deg: 0.0,
+        };
+        let prims = [
+            Primitive::Box { center: [-0.25, 0.0], size: [2.5, 3.0], height: 0.3, yaw_deg: 0.0 },
+            wall(0.75),
+            wall(-0.75),
+        ];
+        let m = rasterise(&prims, [-1.5, -1.5], [6.0, 3.0], 0.025).expect("map");
+        let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
+        let g = graph(&maps, LatticeState::new(0, 0, 0));
+        let (start, goal) = (state_at(&g, 0.0, 0.0), state_at(&g, 3.4, 0.0));
+        let mut g = graph(&maps, goal);
+        let search =
+            SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
+        let r = arastar(&mut g, start, &search).expect("valid params");
+        let best = r.best().unwrap_or_else(|| panic!("no path: {:?}", r.termination));
+        let labels: Vec<Manoeuvre> =
+            best.path.windows(2).filter_map(|w| g.edge(w[0], w[1]).map(|(_, m)| m)).collect();
+        let steps = labels.iter().filter(|m| m.kind == ManoeuvreKind::Step).count();
+        assert_eq!(steps, 4, "every foot steps down once");
+        // A base shift leaves both front feet behind neutral before the first step.
+        let first_step = best
+            .path
+            .windows(2)
+            .position(|w| g.edge(w[0], w[1]).is_some_and(|(_, m)| m.kind == ManoeuvreKind::Step))
+            .expect("a step");
+        assert!(
+            best.path[..=first_step]
+                .iter()
+                .any(|&t| g.offsets(t).is_some_and(|o| o[0] < 0 && o[1] < 0)),
+            "no descent shift before the first step"
+        );
+    }
+
     /// The plain driving heuristic (Euclidean distance plus turn) of `s` in `g`.
     fn driving_heuristic(g: &HybridGraph<'_>, s: LatticeState) -> Cost {
         let l = *g.lattice();
