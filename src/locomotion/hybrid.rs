@@ -92,7 +92,9 @@
 //!   with it tipped over in closed loop).
 //! - *The descent shift* (both step models): a front foot close to an obstacle steps
 //!   down (its cheapest foothold lies lower than the foot by more than a wheel drives
-//!   down) and the front feet do not both stand ahead of neutral. The base shifts
+//!   down), the rear feet stand on its ground (a platform's edge, not the middle of a
+//!   flight, where a long shift tipped the robot over in closed loop) and the front
+//!   feet do not both stand ahead of neutral. The base shifts
 //!   forward past the front feet's neutral until that front hip stands over the middle
 //!   of the step, or the length nearest to it at which every leg stands on the way and
 //!   the foot can still step. It mirrors what a climb gets from the longitudinal shift
@@ -1204,7 +1206,8 @@ impl<'c> HybridGraph<'c> {
     /// The descent shift of state `s` (offsets `o`, feet `feet`, criterion 1 per foot
     /// `near`), in cells: where a front foot close to an obstacle steps down (its
     /// cheapest foothold by the scan lies lower than the foot by more than a wheel drives
-    /// down, `max_foot_height_diff_m`) and the front feet do not both stand ahead of
+    /// down, `max_foot_height_diff_m`), the rear feet stand on its ground, and the front
+    /// feet do not both stand ahead of
     /// neutral (the longitudinal shift's case), the base forward until that front hip
     /// stands over the middle of its step, or the length nearest to it at which every
     /// leg stands on the way ([`Self::shift_in_reach`]) and the front foot can still step
@@ -1220,8 +1223,16 @@ impl<'c> HybridGraph<'c> {
         if o[0] > 0 && o[1] > 0 {
             return None;
         }
+        // A platform's edge, not a flight: the rear feet stand on the stepping foot's
+        // ground. Mid-flight (rear feet on higher treads) a 0.35 m shift planned on
+        // 0.18 m rises and 0.40 m treads tipped the robot over in closed loop.
+        let level = |f: usize| {
+            [2, 3]
+                .iter()
+                .all(|&r| (feet.h[r] - feet.h[f]).abs() <= self.config.max_foot_height_diff_m)
+        };
         let down = |f: usize| -> Option<i32> {
-            if !near[f] {
+            if !near[f] || !level(f) {
                 return None;
             }
             let c = *self.step_candidates(s, o, feet, f).first()?;
