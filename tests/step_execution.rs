@@ -316,6 +316,21 @@ fn stairs_descent_whole_mission_in_closed_loop() {
 }
 
 #[test]
+fn steep_stairs_descent_whole_mission_in_closed_loop() {
+    // Three 0.20 m rises on 0.30 m treads, down: no path until the descent shift. Then,
+    // mid-flight, a planned base shift pitched the base 2.2° past its keyframe (the front
+    // legs give under the shifted weight), a rear wheel pair rose 1 cm off its tread,
+    // and the next rear lift measured −6.4 cm of margin on the two legs left (8.5 cm
+    // planned) and was aborted; the return to the driving posture then rolled a foot off
+    // a tread and the CoM stood 0.41 m outside the support for 1 s. Stance feet that lose
+    // the ground are now lowered until they touch (the stance compliance), and a return
+    // that would roll a foot over an edge is not made (the robot is stranded instead):
+    // every step is lifted, none aborted.
+    let s = run_whole("stairs_descent_steep");
+    assert_eq!(s.steps_aborted, 0, "{:?}", s.executor_events);
+}
+
+#[test]
 fn staircase_whole_mission_in_closed_loop_pitches_with_the_stairs() {
     let s = run_whole("staircase");
     // Treads 0.12 m high and 0.7 m deep, the feet 0.7 m apart: the front feet stand one

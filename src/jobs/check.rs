@@ -348,6 +348,7 @@ pub fn failure_kind_name(kind: FailureKind) -> &'static str {
         FailureKind::PlanningTimeLimit => "planning_time_limit",
         FailureKind::MotionGeneration => "motion_generation",
         FailureKind::Replanning => "replanning",
+        FailureKind::Stranded => "stranded",
         FailureKind::Timeout => "timeout",
     }
 }
@@ -910,7 +911,7 @@ mod tests {
     #[test]
     fn failure_kind_names_are_the_serialised_ones() {
         use FailureKind::*;
-        for k in [NoPath, PlanningTimeLimit, MotionGeneration, Replanning, Timeout] {
+        for k in [NoPath, PlanningTimeLimit, MotionGeneration, Replanning, Stranded, Timeout] {
             assert_eq!(serde_json::to_value(k).unwrap(), failure_kind_name(k), "{k:?}");
         }
         let r = ran(None, summary(false, false, Some(Timeout), false, 0.0), 0.1);

@@ -218,6 +218,9 @@ pub enum FailureKind {
     MotionGeneration,
     /// The executor left the plan and no replan was left or a replan failed.
     Replanning,
+    /// The executor left the plan where the robot cannot return to the driving posture
+    /// a replan starts from (`control::step_executor::Stranding`): it holds its stance.
+    Stranded,
     /// The scenario's simulated-time budget ran out.
     Timeout,
 }
@@ -575,7 +578,6 @@ fn observe(sim: &Simulation, base: &BaseState, measured: Pose2) -> Observation {
         joints: Leg::ALL.map(|l| sim.leg_joints(l)),
         steering: Leg::ALL.map(|l| sim.steering_angle(l)),
         steering_rate: Leg::ALL.map(|l| sim.steering_rate(l)),
-        wheel_angles: Leg::ALL.map(|l| sim.wheel_angles(l)),
         com: sim.center_of_mass(),
         wheel_contacts: sim
             .wheel_contacts()
@@ -652,6 +654,7 @@ pub fn execute(
     let mut finished = false;
     let mut failure = None;
     let mut replans = 0;
+    let mut stranded = false;
     // Counters of executors replaced by a replan.
     let (mut done_executed, mut done_aborted, mut done_events) = (0, 0, Vec::new());
     let mut step_margins: Vec<StepMargin> = Vec::new();
@@ -677,6 +680,11 @@ pub fn execute(
         match status {
             ExecStatus::Finished => {
                 finished = true;
+                break;
+            }
+            ExecStatus::Stranded { failure: f, reason } => {
+                failure = Some(format!("{f}; stranded: {reason}"));
+                stranded = true;
                 break;
             }
             ExecStatus::NeedsReplan(f) => {
@@ -813,7 +821,9 @@ pub fn execute(
     if let Some(r) = recorder.take() {
         r.finish()?;
     }
-    let mut failure_kind = failure.as_ref().map(|_| FailureKind::Replanning);
+    let mut failure_kind = failure
+        .as_ref()
+        .map(|_| if stranded { FailureKind::Stranded } else { FailureKind::Replanning });
     if !finished && failure.is_none() {
         failure = Some(format!("time budget of {timeout} s used up"));
         failure_kind = Some(FailureKind::Timeout);

@@ -7,8 +7,8 @@
 //! height map knows only to a cell rest on three of them: the fourth pair hangs a few
 //! millimetres up, and the CoM sits next to the diagonal of the other three (generated
 //! clutter: 0.6 cm of margin over bumps under 5 cm). A leg whose wheels touch nothing is
-//! extended at `drive_extend_speed_mps` until they do (at most `max_drive_extension_m`),
-//! and the extension is given back at the slower `drive_release_speed_mps` while they
+//! extended at `leg_extend_speed_mps` until they do (at most `max_leg_extension_m`),
+//! and the extension is given back at the slower `leg_release_speed_mps` while they
 //! touch, so every pair keeps the ground and the extension does not outlive the bump.
 
 use super::{Command, ExecFailure, Mode, Observation, StepExecutor, planar};
@@ -20,7 +20,7 @@ use crate::robot::Leg;
 /// How far a drive run moves a foot from its keyframe height to where its wheels rest,
 /// m: the foot cost's largest height difference within r_F (eq. 2), the most a wheel
 /// meets while driving.
-const WHEEL_REST_RANGE_M: f64 = 0.05;
+pub(super) const WHEEL_REST_RANGE_M: f64 = 0.05;
 
 impl StepExecutor {
     /// `p` with each foot at the height where its wheel pair rests on the height map
@@ -68,9 +68,9 @@ impl StepExecutor {
         for leg in Leg::ALL {
             let e = &mut self.drive_extension[leg.index()];
             *e = if obs.leg_in_contact(leg) {
-                (*e - c.drive_release_speed_mps * dt).max(0.0)
+                (*e - c.leg_release_speed_mps * dt).max(0.0)
             } else {
-                (*e + c.drive_extend_speed_mps * dt).min(c.max_drive_extension_m)
+                (*e + c.leg_extend_speed_mps * dt).min(c.max_leg_extension_m)
             };
             p.feet[leg.index()][2] -= *e;
         }
@@ -131,7 +131,6 @@ impl StepExecutor {
         let p = self.on_wheel_rest_heights(p, obs);
         let p = self.complied(p, obs, dt);
         self.cmd = p;
-        self.wheel_hold = [None; 4];
         self.mode = Mode::Drive { follower, first, last };
         let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
         let local = contacts_in_base(&self.robot, &p);

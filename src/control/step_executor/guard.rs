@@ -127,10 +127,14 @@ impl StepExecutor {
             }
             self.active = Some(ActiveStep { number: self.steps_started, leg });
             self.lift_offset = self.foot_offset[leg.index()];
-            // Landing: the drift of the measured base, frozen now.
+            // Landing: the drift of the measured base from the base the legs are solved
+            // for (the position hold's included: with the base held 3 cm off its
+            // keyframes, a foot aimed from the keyframes' base landed 3 cm off its
+            // foothold), frozen now.
             let place = self.place_index(index);
             let foothold = self.keys[place].feet[leg.index()];
-            self.landing = landing_offset(planar(&p), obs.base, [foothold[0], foothold[1]]);
+            let solved = planar(&self.held(&p));
+            self.landing = landing_offset(solved, obs.base, [foothold[0], foothold[1]]);
             self.fading = None;
             self.start_segment(index);
             return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
@@ -252,6 +256,33 @@ mod tests {
         let o = landing_offset(Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.0, 0.0, 0.1), [0.4, 0.0]);
         assert!((o[0] - (0.4 * 0.1f64.cos() - 0.4)).abs() < 1e-12);
         assert!((o[1] + 0.4 * 0.1f64.sin()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_foot_lands_on_its_foothold_with_the_base_held_off_its_keyframes() {
+        // The base stands 2 cm behind its keyframes (x = −0.02): the position hold
+        // integrates, and at the lift the legs are solved for a base h ahead of the
+        // keyframes while the base stands d = −0.02 m off them. A foot commanded at
+        // foothold + L relative to the solved base lands at foothold + L − h + d: the
+        // landing offset must be L = h − d (it was −d, the foot landing h off).
+        let keys = step_path();
+        let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+        let feet = keys[0].feet;
+        let without_fl: Vec<_> =
+            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        let com = [-0.1, -0.1, 0.4];
+        let mut t = 0.0;
+        while ex.active_step().is_none() && t < 2.0 {
+            t += 0.01;
+            let mut o = obs(t, &ex, &without_fl, com);
+            o.base = Pose2::new(-0.02, 0.0, 0.0);
+            ex.tick(&o, 0.01);
+        }
+        assert!(ex.active_step().is_some(), "no lift");
+        let h = ex.base_hold;
+        assert!(h[0] > 0.005 && h[1].abs() < 1e-12, "{h:?}");
+        assert!((ex.landing[0] - (h[0] + 0.02)).abs() < 1e-9, "{:?} {h:?}", ex.landing);
+        assert!(ex.landing[1].abs() < 1e-12);
     }
 
     #[test]

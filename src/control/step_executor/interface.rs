@@ -28,8 +28,6 @@ pub struct ExecutorConfig {
     pub emergency_margin_m: f64,
     /// Time the posture is held before the margin is measured for a lift, s.
     pub lift_settle_s: f64,
-    /// Gain of the stance wheels' angle hold (speed command per rad of creep), 1/s.
-    pub wheel_hold_gain: f64,
     /// Integral gain of the base height hold during standing manoeuvres, 1/s. The leg
     /// joints are position servos (the model's kp): under the robot's weight the support
     /// legs give, most when one foot is lifted and three carry it, and the base sinks
@@ -86,13 +84,14 @@ pub struct ExecutorConfig {
     pub driving_leg_height_m: f64,
     /// Base pitch as a fraction of the slope (Sec. VI-B).
     pub pitch_fraction: f64,
-    /// Speed at which a drive run extends a leg whose wheels have lost the ground, m/s
-    /// (the drive's leg compliance, `drive`).
-    pub drive_extend_speed_mps: f64,
+    /// Speed at which a leg whose wheels have lost the ground is extended, m/s: in a drive
+    /// run (`drive`) and, for the legs a standing manoeuvre plans in contact, while
+    /// standing (`StepExecutor::comply_stance`).
+    pub leg_extend_speed_mps: f64,
     /// Speed at which a drive run gives the extension back while the wheels touch, m/s.
-    pub drive_release_speed_mps: f64,
-    /// Largest extension of a leg during a drive run, m.
-    pub max_drive_extension_m: f64,
+    pub leg_release_speed_mps: f64,
+    /// Largest extension of a leg below its keyframe (driving or standing), m.
+    pub max_leg_extension_m: f64,
     /// Contact confirmation of a placed foot.
     pub contact: ContactConfirmConfig,
     /// The path follower of drive runs.
@@ -109,7 +108,6 @@ impl ExecutorConfig {
             lift_margin_reserve_m: params.lift_margin_reserve_m,
             emergency_margin_m: params.min_lift_margin_m / 2.0,
             lift_settle_s: 0.3,
-            wheel_hold_gain: 5.0,
             base_hold_gain: 2.0,
             max_base_lift_m: 0.04,
             max_base_hold_m: 0.04,
@@ -130,9 +128,9 @@ impl ExecutorConfig {
             recover_angular_speed: 0.2,
             driving_leg_height_m: params.driving_leg_height_m,
             pitch_fraction: params.base_pitch_slope_fraction,
-            drive_extend_speed_mps: 0.05,
-            drive_release_speed_mps: 0.01,
-            max_drive_extension_m: 0.03,
+            leg_extend_speed_mps: 0.05,
+            leg_release_speed_mps: 0.01,
+            max_leg_extension_m: 0.03,
             contact: ContactConfirmConfig::default(),
             follower,
             wheels: WheelKinematics::default(),
@@ -156,8 +154,6 @@ pub struct Observation {
     pub steering: [f64; 4],
     /// Measured steering rates, rad/s.
     pub steering_rate: [f64; 4],
-    /// Measured wheel angles (left, right) per leg, rad.
-    pub wheel_angles: [[f64; 2]; 4],
     /// Whole-robot CoM, m.
     pub com: [f64; 3],
     /// Horizontal contact points of the wheels touching terrain, with their legs.
@@ -249,6 +245,42 @@ pub enum ExecStatus {
     /// The plan was left (see the failure); the robot stands in the driving posture and
     /// needs a new plan.
     NeedsReplan(ExecFailure),
+    /// The plan was left (see the failure) where the robot cannot return to the driving
+    /// posture: a foot's way back to the neutral footprint would roll its wheels over a
+    /// height change no drive may cross (an edge mid-staircase), or a foot of that posture
+    /// is off the known map. The robot holds its stance; no plan (which starts from the driving
+    /// posture) can start here.
+    Stranded {
+        /// Why the plan was left.
+        failure: ExecFailure,
+        /// Why the robot cannot return to the driving posture.
+        reason: Stranding,
+    },
+}
+
+/// Why the robot cannot return to the driving posture after leaving a plan.
+#[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Stranding {
+    /// A foot would roll over an edge on its way back to the neutral footprint.
+    #[error(
+        "{leg:?}'s way back to the driving posture rolls over a {height_change_m:.3} m height change (at most {allowed_m:.3} m)"
+    )]
+    Edge {
+        /// The leg.
+        leg: Leg,
+        /// Height range of the terrain along the foot's way, m.
+        height_change_m: f64,
+        /// The most a driving wheel meets, m.
+        allowed_m: f64,
+    },
+    /// A foot of the driving posture at the robot's pose stands where the map knows no
+    /// height.
+    #[error("a foot of the driving posture, at ({:.2}, {:.2}), is off the known map", at[0], at[1])]
+    OffMap {
+        /// Where the foot would stand, m.
+        at: [f64; 2],
+    },
 }
 
 /// Something the executor did, for the run's summary.

@@ -14,9 +14,12 @@
 //!   targets from the sagittal IK of the interpolated posture (base height, roll, pitch,
 //!   feet). A foot moved along the ground in contact (wheel to centre, wheel back, wheel
 //!   moves) rolls its pair at the foot's world speed over the wheel radius, steering
-//!   straight. Stance wheels need no spin (the ankle keeps a planted wheel level); since
-//!   the wheel actuators are velocity servos, a stance pair holds its wheel angles with a
-//!   proportional loop so the foot does not creep under the legs' horizontal forces.
+//!   straight. Stance wheels get a zero speed target (the ankle keeps a planted wheel
+//!   level): the wheel actuators are velocity servos, so a stance pair gives a little
+//!   under the legs' horizontal push, which relieves the forces the four position-servoed
+//!   legs set up against each other. (Holding the wheel angles stiffly instead, with a
+//!   proportional loop, made 2 of the stairs envelope's 70 flights lose their support
+//!   and 4 more fail.)
 //! - **Base height** in the standing modes (segments, the lift guard, placing, putting
 //!   down): the leg servos give under the robot's weight and the base sinks 1–2 cm below
 //!   its keyframes, carrying a lifted leg's folded knee toward the edge it passes. The
@@ -43,15 +46,21 @@
 //! - **While a foot is in the air** the support margin is watched; below
 //!   [`ExecutorConfig::emergency_margin_m`] the foot is put down where it is (lowered until
 //!   MuJoCo reports contact), and the step is retried from the lift (bounded).
-//! - **Swing foot landing**: the planar drift of the measured base from the commanded one,
-//!   frozen at the lift, is taken out of the foothold, so the foot lands on the world
-//!   foothold rather than on the plan's.
+//! - **Stance feet keep the ground** in the same modes: a leg the posture has bearing
+//!   weight whose wheels touch nothing is lowered until they do (bounded,
+//!   [`ExecutorConfig::max_leg_extension_m`]; the support legs give under a shifted CoM,
+//!   the base pitches past its keyframes and lifts a pair off its tread).
+//! - **Swing foot landing**: the planar drift of the measured base from the base the legs
+//!   are solved for (the position hold included), frozen at the lift, is taken out of the
+//!   foothold, so the foot lands on the world foothold rather than on the plan's.
 //! - **Placing**: after the place keyframe, weight goes back onto the foot only when
 //!   MuJoCo reports contact ([`ContactConfirm`]: the foot is lowered a bounded extra
 //!   distance; no contact fails the step).
 //! - **Failures** (step aborted or failed, drift beyond tolerance, IK): a lifted foot is put
 //!   down, the robot returns to the driving posture at its pose (feet rolled to the
-//!   neutral footprint) and the executor reports [`ExecStatus::NeedsReplan`].
+//!   neutral footprint) and the executor reports [`ExecStatus::NeedsReplan`]; where a
+//!   foot's way back would roll over an edge (mid-staircase) it holds its stance instead
+//!   and reports [`ExecStatus::Stranded`].
 //!
 //! Postures are kept in the plan's coordinates; only the relative geometry of base and
 //! feet reaches the joints, so a small planar offset of the whole robot from the plan does
@@ -81,6 +90,7 @@ pub use actuation::{reachable_leg_targets, rolling_wheel_speed};
 pub use guard::{correction_roll, landing_offset};
 pub use interface::{
     Command, ExecEvent, ExecEventKind, ExecFailure, ExecStatus, ExecutorConfig, Observation,
+    Stranding,
 };
 pub use timing::{clock_rate, motion_duration, smoothstep, smoothstep_rate};
 
@@ -116,6 +126,7 @@ enum Mode {
     Recover { from: Posture, to: Posture, elapsed: f64, duration: f64, failure: ExecFailure },
     Finished,
     Stopped(ExecFailure),
+    Stranded(ExecFailure, Stranding),
 }
 
 /// A step in progress: from the lift to the confirmed contact.
@@ -156,8 +167,6 @@ pub struct StepExecutor {
     /// (`ExecutorConfig::max_base_hold_m`).
     base_hold: [f64; 2],
     last_legs: [[f64; 3]; 4],
-    /// Wheel angles the stance wheels hold (None: not holding), rad.
-    wheel_hold: [Option<[f64; 2]>; 4],
     now: f64,
     retries: usize,
     steps_started: usize,
@@ -206,7 +215,6 @@ impl StepExecutor {
             base_lift: 0.0,
             base_hold: [0.0; 2],
             last_legs,
-            wheel_hold: [None; 4],
             now: 0.0,
             retries: 0,
             steps_started: 0,
@@ -287,8 +295,10 @@ impl StepExecutor {
                     self.keys[i - 1..=last].iter().map(|k| planar(&k.posture())).collect();
                 match PathFollower::new(poses, self.config.follower.clone()) {
                     Ok(f) => {
+                        // The stance compliance's extensions carry over (no jump).
+                        let max = self.config.max_leg_extension_m;
+                        self.drive_extension = self.foot_offset.map(|o| (-o[2]).clamp(0.0, max));
                         self.foot_offset = [[0.0; 3]; 4];
-                        self.drive_extension = [0.0; 4];
                         self.correction = [0.0; 2];
                         self.fading = None;
                         self.mode = Mode::Drive { follower: Box::new(f), first: i, last };
@@ -308,10 +318,12 @@ impl StepExecutor {
     /// One control tick of `dt` s.
     pub fn tick(&mut self, obs: &Observation, dt: f64) -> (Command, ExecStatus) {
         self.hold_base(obs, dt);
+        self.comply_stance(obs, dt);
         let cmd = self.step_mode(obs, dt);
         let status = match &self.mode {
             Mode::Finished => ExecStatus::Finished,
             Mode::Stopped(f) => ExecStatus::NeedsReplan(f.clone()),
+            Mode::Stranded(f, r) => ExecStatus::Stranded { failure: f.clone(), reason: r.clone() },
             _ => ExecStatus::Running,
         };
         (cmd, status)
@@ -372,6 +384,10 @@ impl StepExecutor {
             }
             Mode::Stopped(f) => {
                 self.mode = Mode::Stopped(f);
+                self.hold()
+            }
+            Mode::Stranded(f, r) => {
+                self.mode = Mode::Stranded(f, r);
                 self.hold()
             }
             Mode::Drive { follower, first, last } => {

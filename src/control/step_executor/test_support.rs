@@ -57,7 +57,6 @@ pub(super) fn obs(
         joints: ex.last_legs,
         steering: [0.0; 4],
         steering_rate: [0.0; 4],
-        wheel_angles: [[0.0; 2]; 4],
         com,
         wheel_contacts: contacts.to_vec(),
     }
