@@ -48,7 +48,14 @@
 //!   whose untraversable band is 2 r_F wide);
 //! - a step starts only from a foot within `step_obstacle_distance_m` of an infinite
 //!   cell (criterion 1), so only components holding a cell of the graph's conservative
-//!   "near an obstacle" layer have outgoing step edges.
+//!   "near an obstacle" layer have outgoing step edges;
+//! - a step is no longer than a leg's range of foot offsets (from its reach behind
+//!   neutral to its reach ahead), so a pair whose lower bound on L exceeds that has no
+//!   edge. Without it the bound let a foot on a stair's first tread "step" across a
+//!   1.3 m plateau to the floor beyond at the cost of its 0.1 m rise, where the plateau
+//!   itself had to pay for its 0.3 m drop: the heuristic fell by 40 % going back down
+//!   the stairs, and the greedy probe searched there (generated mixed courses stopped
+//!   at the 120 s limit).
 //!
 //! Of the k7 term only the share `1 − λ` enters `w`: the share λ pays for the
 //! foot-offset potential of the hybrid heuristic ([`offset_potential`]).
@@ -90,6 +97,12 @@
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::planner::Cost;
 
+/// Tolerance of the step height criterion (criterion 3), m: heights built from sums of
+/// floats sit a few ulps off their nominal value (three 0.1 m rises make a plateau
+/// 0.30000000000000004 m high), and a drop of the paper's largest step height must stay
+/// a step. Far below any physical meaning.
+pub const STEP_HEIGHT_TOLERANCE_M: f64 = 1e-9;
+
 /// Largest number of components for which the step bound is computed.
 pub const MAX_COMPONENTS: usize = 2048;
 
@@ -111,6 +124,10 @@ pub struct StepBoundParams {
     pub max_step_height_m: f64,
     /// Link radius R, cells (see the module docs).
     pub link_cells: usize,
+    /// Longest step any foot can make, m: the widest range of a leg's foot offsets
+    /// (its reach behind and ahead of neutral). Components farther apart have no step
+    /// edge.
+    pub max_step_length_m: f64,
     /// k10: base shift weight (C_BS).
     pub k10: f64,
     /// k11 (eq. 6): single foot move weight.
@@ -220,7 +237,7 @@ impl StepBound {
                 return None;
             }
             let gap = (cb.min_h - ca.max_h).max(ca.min_h - cb.max_h).max(0.0);
-            if gap > params.max_step_height_m {
+            if gap > params.max_step_height_m + STEP_HEIGHT_TOLERANCE_M {
                 return None;
             }
             let l = if a == b {
@@ -228,6 +245,9 @@ impl StepBound {
             } else {
                 gaps.as_ref().map_or(l_other, |g| g.get(a, b)).max(l_other)
             };
+            if l > params.max_step_length_m {
+                return None;
+            }
             let c_s = k7 * l + params.k8 * (cb.min_cf - 1.0) + params.k9 * gap;
             Some(Cost::from_f64_floor(params.step_cost_factor * c_s * (1.0 - 1e-9)))
         };
@@ -349,8 +369,10 @@ impl Crossings {
     ) -> Self {
         let (nx, ny) = hm.dims();
         let k = comps.len();
-        // Thresholds to the millimetre, rounded up (a larger threshold only merges).
-        let key = |c: &Component| ((c.max_h + max_step) * 1000.0).ceil() as i64;
+        // Thresholds to the millimetre, rounded up (a larger threshold only merges), with
+        // the criterion's tolerance.
+        let key =
+            |c: &Component| ((c.max_h + max_step + STEP_HEIGHT_TOLERANCE_M) * 1000.0).ceil() as i64;
         let mut keys: Vec<i64> = comps.iter().map(key).collect();
         keys.sort_unstable();
         keys.dedup();

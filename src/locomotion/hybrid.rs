@@ -159,7 +159,7 @@
 use super::cost_to_go::CostToGo;
 use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, edge_cost};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
-use super::heuristic::{StepBound, StepBoundParams};
+use super::heuristic::{STEP_HEIGHT_TOLERANCE_M, StepBound, StepBoundParams};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use super::reachability::BaseRegions;
 use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
@@ -578,7 +578,9 @@ impl<'c> HybridGraph<'c> {
         let foot_move_cells = (config.foot_move_increment_m / res).round().clamp(1.0, 127.0) as i8;
         let near = near_obstacle_layer(maps, config.step_obstacle_distance_m);
         let t0 = Instant::now();
-        let step_bound = build_step_bound(maps, &near, &config, &lattice, goal);
+        let max_step_cells = reach.iter().map(|r| i32::from(r[1]) - i32::from(r[0])).max();
+        let max_step_length_m = f64::from(max_step_cells.unwrap_or(0).max(0)) * res;
+        let step_bound = build_step_bound(maps, &near, &config, &lattice, goal, max_step_length_m);
         // A base shift costs at least f · k10 per metre (C_B ≥ 1) and raises the
         // foot-offset potential by 4 c per cell (`heuristic::offset_potential`).
         let shift_step =
@@ -1180,7 +1182,7 @@ impl<'c> HybridGraph<'c> {
             // Unknown terrain cannot be stepped over: the leg could hit anything.
             let Some(h) = hm.get(i, j) else { break };
             dh_max = dh_max.max((h - h0).abs());
-            if dh_max > self.config.max_step_height_m {
+            if dh_max > self.config.max_step_height_m + STEP_HEIGHT_TOLERANCE_M {
                 break;
             }
             let cf = match self.maps.foot_cost_cell_at(i, j, bin) {
@@ -2046,6 +2048,7 @@ fn build_step_bound(
     config: &HybridConfig,
     lattice: &Lattice,
     goal: DrivingGoal,
+    max_step_length_m: f64,
 ) -> StepBound {
     let res = lattice.resolution;
     let radius = maps.neutral_footprint().iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
@@ -2059,6 +2062,7 @@ fn build_step_bound(
         k9: config.k9,
         max_step_height_m: config.max_step_height_m,
         link_cells,
+        max_step_length_m,
         k10: config.k10,
         k11: config.k11,
     };

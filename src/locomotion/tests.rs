@@ -690,6 +690,66 @@ mod hybrid {
         assert!(pf.to_go.to_f64() >= pf.driving.to_f64() - 1e-4, "{pf:?}");
     }
 
+    #[test]
+    fn a_step_longer_than_the_legs_reach_is_no_step_edge() {
+        // Floor, a 0.25 m platform 1.5 m deep (edges on cell boundaries at x = 1.15 and
+        // 2.65, as the platform test's at 1.0), floor again with the goal. Every cell a
+        // foot would pass going straight across stays within 0.3 m of the floor, and both
+        // floors are 0 m high: a single "step" floor to floor would cost only k7 · L.
+        // No step is longer than a leg's range of offsets (1 m), so each foot pays the
+        // step up and the step down, each as in `step_bound_is_one_platform_step_per_foot`.
+        let prims =
+            [Primitive::Box { center: [1.9, 0.0], size: [1.5, 2.0], height: 0.25, yaw_deg: 0.0 }];
+        let m = rasterise(&prims, [-1.0, -1.0], [5.0, 2.0], 0.025).expect("map");
+        let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
+        let probe = graph(&maps, LatticeState::new(0, 0, 0));
+        let goal = state_at(&probe, 3.5, 0.0);
+        let g = graph(&maps, goal);
+        let p = Params::default();
+        let f = p.step_cost_factor;
+        let octile = (1.0 + (std::f64::consts::SQRT_2 - 1.0).powi(2)).sqrt();
+        let l = (11.0 / octile - std::f64::consts::SQRT_2) * 0.025 * (1.0 - 1e-9);
+        let lambda = p.k11 / p.k7;
+        let edge =
+            Cost::from_f64_floor(f * ((1.0 - lambda) * p.k7 * l + p.k9 * 0.25) * (1.0 - 1e-9));
+        let steps = g.heuristic_parts(state_at(&g, 0.0, 0.0)).steps;
+        assert_eq!(steps, Cost(8 * edge.0), "{steps} against {edge} per step");
+    }
+
+    #[test]
+    fn a_platform_three_0_1_m_rises_high_is_within_the_step_height() {
+        // 0.1 + 0.1 + 0.1 = 0.30000000000000004 m: the paper's largest step, a few ulps
+        // over. The step bound found no step edge onto it and the step scan stopped at
+        // its edge: four generated mixed courses descending such a plateau searched the
+        // whole map (120 s) for a path the criterion forbade. Such a platform is now the
+        // 0.3 m platform: the same bound, the same steps from every pose before it.
+        let exact = platform_maps(0.3);
+        let sum = platform_maps(0.1 + 0.1 + 0.1);
+        let goal = LatticeState::new(120, 40, 0);
+        let (mut a, mut b) = (graph(&exact, goal), graph(&sum, goal));
+        let s = state_at(&a, 0.0, 0.0);
+        assert!(!b.heuristic(s).is_infinite());
+        assert_eq!(a.heuristic_parts(s).steps, b.heuristic_parts(s).steps);
+        let mut steps = 0;
+        for k in 0..40 {
+            for o in [0, 4, 8, 12] {
+                let base = state_at(&a, 0.025 * f64::from(k), 0.0);
+                let of = |g: &mut HybridGraph<'_>| -> Vec<_> {
+                    let s = g.with_offsets(base, [o, o, 0, 0]).expect("interned");
+                    g.labelled_successors(s)
+                        .into_iter()
+                        .filter(|(_, _, m)| m.kind == ManoeuvreKind::Step)
+                        .map(|(t, c, m)| (g.offsets(t), c, m.leg))
+                        .collect()
+                };
+                let (sa, sb) = (of(&mut a), of(&mut b));
+                steps += sa.len();
+                assert_eq!(sa, sb, "base at x = {}, front offsets {o}", 0.025 * f64::from(k));
+            }
+        }
+        assert!(steps > 0, "no step up from the poses tried");
+    }
+
     /// Checks `h(s) ≤ c(s, t) + h(t)` on every labelled successor of `s` and on every
     /// edge the search itself takes out of `s` and out of the lazy steps' intermediate
     /// nodes it reaches (`hybrid` module docs, "Lazy step checks"); returns the labelled
