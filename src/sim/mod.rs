@@ -65,8 +65,6 @@ struct LegIds {
     qpos: [usize; 4],
     /// qvel addresses of the two wheels.
     wheel_qvel: [usize; 2],
-    /// qpos addresses of the two wheels.
-    wheel_qpos: [usize; 2],
     /// qvel address of the steering joint.
     steer_qvel: usize,
     /// Geoms of the two wheels.
@@ -255,22 +253,13 @@ impl Simulation {
             ];
             let (w0, w1) = (joint_adr(&names.wheels[0])?, joint_adr(&names.wheels[1])?);
             let wheel_qvel = [w0.1, w1.1];
-            let wheel_qpos = [w0.0, w1.0];
             let steer_qvel = joint_adr(&format!("{p}_steer"))?.1;
             let wheel_geoms = [
                 model::id(&model, MjtObjBase::mjOBJ_GEOM, &names.wheels[0])?,
                 model::id(&model, MjtObjBase::mjOBJ_GEOM, &names.wheels[1])?,
             ];
             let steer_body = model::id(&model, MjtObjBase::mjOBJ_BODY, &names.steer)?;
-            legs.push(LegIds {
-                actuators,
-                qpos,
-                wheel_qvel,
-                wheel_qpos,
-                steer_qvel,
-                wheel_geoms,
-                steer_body,
-            });
+            legs.push(LegIds { actuators, qpos, wheel_qvel, steer_qvel, wheel_geoms, steer_body });
         }
         let legs: [LegIds; 4] =
             legs.try_into().map_err(|_| SimError::BadModel("leg count".into()))?;
@@ -391,13 +380,6 @@ impl Simulation {
     /// Measured steering rate, rad/s.
     pub fn steering_rate(&self, leg: Leg) -> f64 {
         self.data.qvel()[self.legs[leg.index()].steer_qvel]
-    }
-
-    /// Measured wheel angles (left, right), rad.
-    pub fn wheel_angles(&self, leg: Leg) -> [f64; 2] {
-        let ids = self.legs[leg.index()];
-        let qpos = self.data.qpos();
-        [qpos[ids.wheel_qpos[0]], qpos[ids.wheel_qpos[1]]]
     }
 
     /// Measured wheel speeds (left, right), rad/s.
