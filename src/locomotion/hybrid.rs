@@ -92,9 +92,7 @@
 //!   with it tipped over in closed loop).
 //! - *The descent shift* (both step models): a front foot close to an obstacle steps
 //!   down (its cheapest foothold lies lower than the foot by more than a wheel drives
-//!   down), the rear feet stand on its ground (a platform's edge, not the middle of a
-//!   flight, where a long shift tipped the robot over in closed loop) and the front
-//!   feet do not both stand ahead of neutral. The base shifts
+//!   down) and the front feet do not both stand ahead of neutral. The base shifts
 //!   forward past the front feet's neutral until that front hip stands over the middle
 //!   of the step, or the length nearest to it at which every leg stands on the way and
 //!   the foot can still step. It mirrors what a climb gets from the longitudinal shift
@@ -103,6 +101,9 @@
 //!   at every height from which it still reaches a floor 0.24 m or more below, beyond the
 //!   edge's untraversable band, and every such drop had no path. A base shift like the
 //!   others (same cost, same heuristic terms), so the heuristic stays consistent.
+//!   Offered mid-flight as at a platform's edge: the one flight on which a mid-flight
+//!   shift tipped the robot over lost a stance pair to the base's pitch, an executor
+//!   defect its stance compliance fixed (`control::step_executor`).
 //! - *Flights longer than the robot* (four or more building-code steps) need the last
 //!   two and the partial foot to neutral: without them a rear foot short of a riser
 //!   could neither step nor roll up to it, and every reachable pose was searched
@@ -1208,8 +1209,7 @@ impl<'c> HybridGraph<'c> {
     /// The descent shift of state `s` (offsets `o`, feet `feet`, criterion 1 per foot
     /// `near`), in cells: where a front foot close to an obstacle steps down (its
     /// cheapest foothold by the scan lies lower than the foot by more than a wheel drives
-    /// down, `max_foot_height_diff_m`), the rear feet stand on its ground, and the front
-    /// feet do not both stand ahead of
+    /// down, `max_foot_height_diff_m`) and the front feet do not both stand ahead of
     /// neutral (the longitudinal shift's case), the base forward until that front hip
     /// stands over the middle of its step, or the length nearest to it at which every
     /// leg stands on the way ([`Self::shift_in_reach`]) and the front foot can still step
@@ -1225,16 +1225,8 @@ impl<'c> HybridGraph<'c> {
         if o[0] > 0 && o[1] > 0 {
             return None;
         }
-        // A platform's edge, not a flight: the rear feet stand on the stepping foot's
-        // ground. Mid-flight (rear feet on higher treads) a 0.35 m shift planned on
-        // 0.18 m rises and 0.40 m treads tipped the robot over in closed loop.
-        let level = |f: usize| {
-            [2, 3]
-                .iter()
-                .all(|&r| (feet.h[r] - feet.h[f]).abs() <= self.config.max_foot_height_diff_m)
-        };
         let down = |f: usize| -> Option<i32> {
-            if !near[f] || !level(f) {
+            if !near[f] {
                 return None;
             }
             let c = *self.step_candidates(s, o, feet, f).first()?;

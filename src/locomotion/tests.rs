@@ -599,6 +599,73 @@ mod hybrid {
         );
     }
 
+    #[test]
+    fn descends_a_flight_with_the_descent_shift_mid_flight() {
+        // Three 0.20 m rises on 0.25 m treads, walked down head-on (stairs step model,
+        // wheel-pair feet, as `momaro envelope stairs` plans them). Stop 27 restricted
+        // the descent shift to a platform's edge (rear feet on the stepping foot's
+        // ground) after a mid-flight shift tipped the robot over; with the executor's
+        // stance compliance that shift is safe, and without it a front foot on a middle
+        // tread cannot step down: this flight had no path.
+        let stairs = Primitive::Stairs {
+            start: [0.0, 0.0],
+            width: 1.8,
+            steps: 3,
+            step_depth: 0.25,
+            step_height: 0.2,
+            landing_depth: 3.0,
+            yaw_deg: 0.0,
+        };
+        let m = rasterise(&[stairs], [-2.0, -1.5], [6.05, 3.0], 0.025).expect("map");
+        let params = Params {
+            step_model: crate::params::StepModel::Stairs,
+            foot_model: crate::params::FootModel::WheelPair,
+            ..Params::default()
+        };
+        let maps = CostMaps::build(&m, &robot(), &params).expect("cost maps");
+        let at = |g: &HybridGraph<'_>, x: f64| {
+            g.lattice().state(&Pose2::new(x, 0.0, std::f64::consts::PI)).expect("on the map")
+        };
+        let cfg = HybridConfig::new(&params, &robot(), Neighbourhood::N16);
+        let goal = {
+            let g = HybridGraph::new(
+                &maps,
+                &robot(),
+                64,
+                cfg,
+                DrivingGoal::at(LatticeState::new(0, 0, 0)),
+            )
+            .expect("graph");
+            at(&g, -1.0)
+        };
+        let mut g =
+            HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("graph");
+        let start = at(&g, 2.15);
+        let search =
+            SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
+        let r = arastar(&mut g, start, &search).expect("valid params");
+        let best = r.best().unwrap_or_else(|| panic!("no path: {:?}", r.termination));
+        // A base shift past the front feet's neutral before a front foot steps down from a
+        // tread below the rear feet.
+        let ground = |g: &HybridGraph<'_>, s: LatticeState| -> [f64; 4] {
+            let f = g.feet(s).expect("feet");
+            f.map(|p| g.height_at(p[0], p[1]).expect("on the map"))
+        };
+        let labels: Vec<Manoeuvre> =
+            best.path.windows(2).filter_map(|w| g.edge(w[0], w[1]).map(|(_, m)| m)).collect();
+        let mid_flight_shift = (0..labels.len()).any(|i| {
+            let next_step = (i + 1..labels.len()).find(|&k| labels[k].kind == ManoeuvreKind::Step);
+            let Some(k) = next_step else { return false };
+            let Some(f) = labels[k].leg.map(Leg::index).filter(|&f| f < 2) else { return false };
+            let (before, after) = (ground(&g, best.path[i]), ground(&g, best.path[k + 1]));
+            labels[i].kind == ManoeuvreKind::BaseShift
+                && g.offsets(best.path[i + 1]).is_some_and(|o| o[0] < 0 && o[1] < 0)
+                && before[2].min(before[3]) > before[f] + 0.1
+                && after[f] < before[f] - 0.1
+        });
+        assert!(mid_flight_shift, "no descent shift mid-flight (cost {})", best.cost);
+    }
+
     /// The plain driving heuristic (Euclidean distance plus turn) of `s` in `g`.
     fn driving_heuristic(g: &HybridGraph<'_>, s: LatticeState) -> Cost {
         let l = *g.lattice();
