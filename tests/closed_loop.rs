@@ -83,7 +83,23 @@ fn ramp_detour_drives_up_the_ramp_with_the_pitch_following_the_slope() {
 /// measured: the course is driven with at least 2 cm of margin and no static violation.
 #[test]
 fn a_start_off_the_lattice_keeps_its_wheels_on_the_ground() {
-    let sc = common::generated(momaro::scenario::generate::Class::Clutter, 52);
+    drives_generated_clutter_on_all_wheels(52);
+}
+
+/// A generated clutter field (`momaro generate --class clutter --seed 104`) whose way
+/// crosses the edge of a 3.7 cm bump box at 0.45 m/s. The base rose with the wheels'
+/// rest height as fast as the height map stepped, 0.5 m/s, and when the rise stopped the
+/// robot flew on: every wheel off the ground for 60 ms and the CoM 0.25 m outside the
+/// support of the wheels that came down first. The base's rise is now rate-limited.
+#[test]
+fn a_bump_edge_driven_at_speed_does_not_launch_the_robot() {
+    drives_generated_clutter_on_all_wheels(104);
+}
+
+/// Runs generated clutter seed `seed` (ARA*'s first solution) and asserts that it
+/// passes with at least 2 cm of margin and no static violation at all.
+fn drives_generated_clutter_on_all_wheels(seed: u64) {
+    let sc = common::generated(momaro::scenario::generate::Class::Clutter, seed);
     let plan =
         PlanOptions { time_limit_s: 600.0, final_epsilon: Some(3.0), ..PlanOptions::default() };
     let s = run(&sc, &RunOptions::new(plan, common::model())).expect("run completes");

@@ -13,6 +13,9 @@ use crate::robot::Leg;
 use crate::stability::stability_margin;
 use serde::Serialize;
 
+/// Gravity, m/s²: MuJoCo's default, which `models/momaro.xml` keeps.
+const STANDARD_GRAVITY: f64 = 9.81;
+
 /// Tuning of the executor.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExecutorConfig {
@@ -92,6 +95,10 @@ pub struct ExecutorConfig {
     pub leg_release_speed_mps: f64,
     /// Largest extension of a leg below its keyframe (driving or standing), m.
     pub max_leg_extension_m: f64,
+    /// Fastest rise or fall of a drive run's base with the ground under its wheels, m/s
+    /// (`drive`): `√(2 g h)` for h = 1 mm, the speed at which a base whose rise stopped
+    /// at once would carry its wheels 1 mm off the ground.
+    pub base_rise_speed_mps: f64,
     /// Contact confirmation of a placed foot.
     pub contact: ContactConfirmConfig,
     /// The path follower of drive runs.
@@ -131,6 +138,7 @@ impl ExecutorConfig {
             leg_extend_speed_mps: 0.05,
             leg_release_speed_mps: 0.01,
             max_leg_extension_m: 0.03,
+            base_rise_speed_mps: (2.0 * STANDARD_GRAVITY * 0.001).sqrt(),
             contact: ContactConfirmConfig::default(),
             follower,
             wheels: WheelKinematics::default(),

@@ -152,6 +152,8 @@ pub struct StepExecutor {
     foot_offset: [[f64; 3]; 4],
     /// Per-leg extension of a drive run's legs whose wheels lost the ground, m (`drive`).
     drive_extension: [f64; 4],
+    /// A drive run's rise of the base with the ground under its wheels, m (`drive`).
+    drive_rise: f64,
     /// Stabilising base correction (plan coordinates), m.
     correction: [f64; 2],
     /// The correction at the start of the segment that fades it out.
@@ -208,6 +210,7 @@ impl StepExecutor {
             cmd,
             foot_offset: [[0.0; 3]; 4],
             drive_extension: [0.0; 4],
+            drive_rise: 0.0,
             correction: [0.0; 2],
             fading: None,
             lift_offset: [0.0; 3],
@@ -298,6 +301,7 @@ impl StepExecutor {
                         // The stance compliance's extensions carry over (no jump).
                         let max = self.config.max_leg_extension_m;
                         self.drive_extension = self.foot_offset.map(|o| (-o[2]).clamp(0.0, max));
+                        self.drive_rise = 0.0;
                         self.foot_offset = [[0.0; 3]; 4];
                         self.correction = [0.0; 2];
                         self.fading = None;
