@@ -275,6 +275,13 @@ mod hybrid {
         g.lattice().state(&Pose2::new(x, y, 0.0)).expect("on the map")
     }
 
+    /// The lattice state at pose (x, y, yaw) of any graph on `maps` (64 orientations, as
+    /// `graph` builds them), without building one.
+    fn state_on(maps: &CostMaps, x: f64, y: f64, yaw: f64) -> LatticeState {
+        let lattice = Lattice::for_map(maps.heights(), 64).expect("lattice");
+        lattice.state(&Pose2::new(x, y, yaw)).expect("on the map")
+    }
+
     fn config() -> HybridConfig {
         HybridConfig::new(&Params::default(), &robot(), Neighbourhood::N16)
     }
@@ -574,8 +581,7 @@ mod hybrid {
         ];
         let m = rasterise(&prims, [-1.5, -1.5], [6.0, 3.0], 0.025).expect("map");
         let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
-        let g = graph(&maps, LatticeState::new(0, 0, 0));
-        let (start, goal) = (state_at(&g, 0.0, 0.0), state_at(&g, 3.4, 0.0));
+        let (start, goal) = (state_on(&maps, 0.0, 0.0, 0.0), state_on(&maps, 3.4, 0.0, 0.0));
         let mut g = graph(&maps, goal);
         let search =
             SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
@@ -623,24 +629,11 @@ mod hybrid {
             ..Params::default()
         };
         let maps = CostMaps::build(&m, &robot(), &params).expect("cost maps");
-        let at = |g: &HybridGraph<'_>, x: f64| {
-            g.lattice().state(&Pose2::new(x, 0.0, std::f64::consts::PI)).expect("on the map")
-        };
+        let down = std::f64::consts::PI;
+        let (start, goal) = (state_on(&maps, 2.15, 0.0, down), state_on(&maps, -1.0, 0.0, down));
         let cfg = HybridConfig::new(&params, &robot(), Neighbourhood::N16);
-        let goal = {
-            let g = HybridGraph::new(
-                &maps,
-                &robot(),
-                64,
-                cfg,
-                DrivingGoal::at(LatticeState::new(0, 0, 0)),
-            )
-            .expect("graph");
-            at(&g, -1.0)
-        };
         let mut g =
             HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("graph");
-        let start = at(&g, 2.15);
         let search =
             SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
         let r = arastar(&mut g, start, &search).expect("valid params");
@@ -686,13 +679,13 @@ mod hybrid {
             CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps")
         };
         let high = wall(0.5);
-        let goal_high = state_at(&graph(&high, LatticeState::new(0, 0, 0)), 2.5, 0.0);
+        let goal_high = state_on(&high, 2.5, 0.0, 0.0);
         let g = graph(&high, goal_high);
         assert!(g.heuristic(state_at(&g, 0.0, 0.0)).is_infinite(), "0.5 m wall");
         assert!(!g.heuristic(state_at(&g, 2.4, 0.0)).is_infinite(), "the goal's side");
         // A 0.25 m bar can be stepped over: the bound stays finite.
         let low = wall(0.25);
-        let goal_low = state_at(&graph(&low, LatticeState::new(0, 0, 0)), 2.5, 0.0);
+        let goal_low = state_on(&low, 2.5, 0.0, 0.0);
         let g = graph(&low, goal_low);
         assert!(!g.heuristic(state_at(&g, 0.0, 0.0)).is_infinite(), "0.25 m bar");
     }
@@ -769,8 +762,7 @@ mod hybrid {
             [Primitive::Box { center: [1.9, 0.0], size: [1.5, 2.0], height: 0.25, yaw_deg: 0.0 }];
         let m = rasterise(&prims, [-1.0, -1.0], [5.0, 2.0], 0.025).expect("map");
         let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
-        let probe = graph(&maps, LatticeState::new(0, 0, 0));
-        let goal = state_at(&probe, 3.5, 0.0);
+        let goal = state_on(&maps, 3.5, 0.0, 0.0);
         let g = graph(&maps, goal);
         let p = Params::default();
         let f = p.step_cost_factor;
@@ -1003,7 +995,7 @@ mod hybrid {
             free_goal_theta in proptest::prelude::any::<bool>(),
         ) {
             let maps = random_maps(&boxes);
-            let goal = state_at(&graph(&maps, LatticeState::new(0, 0, 0)), 2.0, 0.0);
+            let goal = state_on(&maps, 2.0, 0.0, 0.0);
             // Both forms of the cost-to-go: per orientation, and one layer for all.
             let cfg = HybridConfig {
                 max_oriented_nodes: if one_layer { 0 } else { usize::MAX },
@@ -1099,9 +1091,7 @@ mod hybrid {
             [Primitive::Box { center: [1.8, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 }];
         let m = rasterise(&prims, [-0.8, -0.8], [3.2, 1.6], 0.025).expect("map");
         let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("maps");
-        let g = graph(&maps, LatticeState::new(0, 0, 0));
-        let start = state_at(&g, 0.0, 0.0);
-        let goal = state_at(&g, 1.5, 0.0);
+        let (start, goal) = (state_on(&maps, 0.0, 0.0, 0.0), state_on(&maps, 1.5, 0.0, 0.0));
         let cfg = config();
         let mut g = HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("g");
         let h0 = g.heuristic(start);

@@ -190,10 +190,9 @@ mod tests {
 
     #[test]
     fn wheels_rest_on_the_ground_under_the_measured_base_not_the_keyframes() {
-        // The front-left bump. With the base measured where
-        // the keyframes put it, the front-left wheels rest on the bump and the base rises
-        // 4 cm; with the base measured 0.3 m behind, the wheels stand on the floor and
-        // nothing rises.
+        // The front-left bump. With the base measured where the keyframes put it, the
+        // front-left wheels rest on the bump and the base rises 4 cm; with the base
+        // measured 0.3 m behind, the wheels stand on the floor and nothing rises.
         let ex = StepExecutor::new(&robot(), config(), step_path(), front_left_bump());
         let p = standing();
         let mut o = obs(0.0, &ex, &[], [0.0; 3]);
