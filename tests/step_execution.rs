@@ -4,8 +4,8 @@
 //!
 //! The paper's two missions whole (plan, expand, execute: goal reached, every step
 //! executed, margin kept, no tip-over, no body collision), a push during a swing, an
-//! aborted step with its replan, and a generated step down whose sunken base once carried
-//! a knee into the edge.
+//! aborted step with its replan, a run stopped by a failure while the robot falls, and a
+//! generated step down whose sunken base once carried a knee into the edge.
 
 mod common;
 
@@ -407,4 +407,55 @@ fn a_generated_step_down_keeps_its_knees_off_the_edge() {
     assert!(s.steps_planned > 0);
     assert_clean(&s);
     assert!(s.passed, "{s:#?}");
+}
+
+/// Plans the platform and executes it with a lift threshold no posture meets (30 cm, for
+/// the executor only) and no replans: the first step is aborted, the robot returns to the
+/// driving posture and the run stops. With `push`.
+fn aborted_platform(push: Option<Push>) -> RunSummary {
+    let planned = common::scenario("platform");
+    let mut sc = planned.clone();
+    sc.params.min_lift_margin_m = 0.3;
+    let opts =
+        RunOptions { max_replans: 0, push, ..RunOptions::new(plan_options(), common::model()) };
+    let wall = Instant::now();
+    let mut sim = Simulation::new(&sc, &common::model()).expect("world compiles");
+    let robot = sim.robot().clone();
+    let plan = plan::run(&planned, &robot, &plan_options()).expect("plan");
+    let detailed =
+        run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
+    momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
+    run::execute(&sc, &mut sim, Mission { plan, detailed }, &opts, wall).expect("runs")
+}
+
+#[test]
+fn a_run_that_stops_while_the_robot_falls_reports_the_fall() {
+    // The run stops after the aborted step's failure and the return to the driving
+    // posture, at `stop`; a shove sideways and up starts 50 ms before. The robot goes over after the executor has given up: the
+    // simulation goes on for `WATCH_AFTER_STOP_S` and the monitor reports the tip-over
+    // (before, the run ended at the failure and reported none).
+    let calm = aborted_platform(None);
+    assert!(calm.failure.as_deref().is_some_and(|f| f.contains("no replans left")), "{calm:#?}");
+    assert!(!calm.tipped, "{calm:#?}");
+    // The simulation went on after the stop for the watch.
+    let stop = calm.sim_time_s - run::WATCH_AFTER_STOP_S;
+    assert!(
+        calm.executor_events.iter().all(|e| e.time_s <= stop + 1e-9),
+        "executor events after the stop at {stop:.2} s: {:?}",
+        calm.executor_events
+    );
+    let push =
+        Push { when: PushWhen::At(stop - 0.05), force: [0.0, 1500.0, 1200.0], duration_s: 0.3 };
+    let shoved = aborted_platform(Some(push));
+    println!("stop {stop:.2} s; shoved: tipped {}, events {:?}", shoved.tipped, shoved.events);
+    assert!(shoved.tipped, "{shoved:#?}");
+    let tip = shoved
+        .events
+        .iter()
+        .find_map(|e| match e {
+            momaro::monitor::MonitorEvent::TipOver { time_s, .. } => Some(*time_s),
+            _ => None,
+        })
+        .expect("a tip-over event");
+    assert!(tip > stop, "the robot went over at {tip:.2} s, before the run stopped at {stop:.2} s");
 }

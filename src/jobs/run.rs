@@ -10,15 +10,16 @@
 //! a placed foot. When the executor leaves the plan (step aborted or failed, drift), the
 //! robot returns to the driving posture and the job replans from the simulated pose
 //! (ARA*, time-limited; a bounded number of times). The stability monitor measures the
-//! margin of MuJoCo's CoM over the wheels in contact; the scenario's expectations decide
-//! the verdict.
+//! margin of MuJoCo's CoM over the wheels in contact, and keeps measuring for
+//! [`WATCH_AFTER_STOP_S`] after a failure stops the run; the scenario's expectations
+//! decide the verdict.
 
 use super::detailed::DetailedJobError;
 use super::plan::{self, PlanJobError, PlanOptions, PlanSummary};
 use super::sim::{CONTROL_HZ, SETTLE_S};
 use crate::control::path_follower::FollowerConfig;
 use crate::control::step_executor::{
-    ExecEvent, ExecStatus, ExecutorConfig, Observation, StepExecutor,
+    Command, ExecEvent, ExecStatus, ExecutorConfig, Observation, StepExecutor,
 };
 use crate::geometry::{Pose2, wrap_angle};
 use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor};
@@ -568,6 +569,22 @@ fn chain(e: &dyn std::error::Error) -> String {
     s
 }
 
+/// How long the simulation goes on, the executor holding its stance, after a failure
+/// stops a run (stranded, no replan left, a replan that failed), s: long enough for a
+/// robot tipping over when the run stopped to fall (a fall from standing height takes
+/// about 0.3 s, a slow tip about 1 s).
+pub const WATCH_AFTER_STOP_S: f64 = 2.0;
+
+/// Sends the executor's command to the simulated actuators.
+fn actuate(sim: &mut Simulation, cmd: &Command) {
+    for leg in Leg::ALL {
+        let i = leg.index();
+        sim.set_leg_joint_targets(leg, cmd.legs[i]);
+        sim.set_steering_target(leg, cmd.wheels[i].steer);
+        sim.set_wheel_speeds(leg, cmd.wheels[i].wheel_speeds);
+    }
+}
+
 /// What the executor sees of the simulation, with `measured` as the planar base pose and
 /// the height of `base` (the simulated base, read once per tick).
 fn observe(sim: &Simulation, base: &BaseState, measured: Pose2) -> Observation {
@@ -732,12 +749,7 @@ pub fn execute(
             }
             ExecStatus::Running => {}
         }
-        for leg in Leg::ALL {
-            let i = leg.index();
-            sim.set_leg_joint_targets(leg, cmd.legs[i]);
-            sim.set_steering_target(leg, cmd.wheels[i].steer);
-            sim.set_wheel_speeds(leg, cmd.wheels[i].wheel_speeds);
-        }
+        actuate(sim, &cmd);
         // The disturbance, if any.
         if let Some(p) = &opts.push {
             let now = sim.time();
@@ -814,6 +826,37 @@ pub fn execute(
             r.log_scalar(sim.time(), "tracking_error_m", track)?;
         }
         progress.set(sim.time());
+    }
+    // A run stopped by a failure ends with the robot holding its last posture, perhaps
+    // already falling: a stranded run on generated stairs ended at the drift check with
+    // the robot pitching over backward at 15.8° and reported no tip-over. The simulation
+    // goes on for `WATCH_AFTER_STOP_S` with the executor holding its stance (and a push
+    // still on ending on time), and the monitor keeps watching.
+    if failure.is_some() {
+        let until = sim.time() + WATCH_AFTER_STOP_S;
+        while sim.time() < until {
+            let base = sim.base();
+            let truth = Pose2::new(base.position[0], base.position[1], base.rpy[2]);
+            let (cmd, _) = exec.tick(&observe(sim, &base, truth), control_dt);
+            actuate(sim, &cmd);
+            if let (Some(r), Some(p)) = (&push_report, &opts.push)
+                && sim.time() >= r.start_s + p.duration_s
+            {
+                sim.push_base([0.0; 3]);
+            }
+            sim.step(substeps)?;
+            let sample = monitor.observe(sim);
+            if let (Some(r), Some(p)) = (&mut push_report, &opts.push)
+                && sim.time() <= r.start_s + p.duration_s + 2.0
+            {
+                r.min_margin_after_m = r.min_margin_after_m.min(sample.margin);
+                if sample.margin < 0.0 {
+                    r.negative_margin_s += control_dt;
+                }
+                r.max_tilt_deg = r.max_tilt_deg.max(sample.tilt().to_degrees());
+            }
+            max_pitch = max_pitch.max(sim.base().rpy[1].abs());
+        }
     }
     progress.finish();
     monitor.finish();
