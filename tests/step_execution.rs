@@ -355,22 +355,13 @@ fn an_aborted_step_returns_to_the_driving_posture_and_replans() {
     // there (once). The planner asks the same threshold of its steps, so the replan finds
     // no path (or, were one found, its first step would be aborted again with no replan
     // left). Either way the run stops, reported.
-    let planned = common::scenario("staircase");
-    let mut sc = planned.clone();
-    sc.params.min_lift_margin_m = 0.3;
     let opts = RunOptions {
         max_replans: 1,
         replan_time_limit_s: 30.0,
         ..RunOptions::new(plan_options(), common::model())
     };
-    let wall = Instant::now();
-    let mut sim = Simulation::new(&sc, &common::model()).expect("world compiles");
-    let robot = sim.robot().clone();
-    let plan = plan::run(&planned, &robot, &plan_options()).expect("plan");
-    let detailed =
-        run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
-    momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
-    let s = run::execute(&sc, &mut sim, Mission { plan, detailed }, &opts, wall).expect("runs");
+    let (s, sim) = execute_unliftable("staircase", opts);
+    let sc = common::scenario("staircase");
     println!("abort: {:?} / {:?}", s.failure, s.executor_events);
     assert!(s.steps_aborted >= 1 && s.steps_executed == 0, "{s:#?}");
     assert!(
@@ -409,15 +400,13 @@ fn a_generated_step_down_keeps_its_knees_off_the_edge() {
     assert!(s.passed, "{s:#?}");
 }
 
-/// Plans the platform and executes it with a lift threshold no posture meets (30 cm, for
-/// the executor only) and no replans: the first step is aborted, the robot returns to the
-/// driving posture and the run stops. With `push`.
-fn aborted_platform(push: Option<Push>) -> RunSummary {
-    let planned = common::scenario("platform");
+/// Plans scenario `name` with the paper's lift threshold and executes it with one no
+/// posture meets (30 cm, for the executor only), so that its first step is aborted:
+/// the run and the simulation it ran in.
+fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) {
+    let planned = common::scenario(name);
     let mut sc = planned.clone();
     sc.params.min_lift_margin_m = 0.3;
-    let opts =
-        RunOptions { max_replans: 0, push, ..RunOptions::new(plan_options(), common::model()) };
     let wall = Instant::now();
     let mut sim = Simulation::new(&sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
@@ -425,7 +414,16 @@ fn aborted_platform(push: Option<Push>) -> RunSummary {
     let detailed =
         run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
     momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
-    run::execute(&sc, &mut sim, Mission { plan, detailed }, &opts, wall).expect("runs")
+    let s = run::execute(&sc, &mut sim, Mission { plan, detailed }, &opts, wall).expect("runs");
+    (s, sim)
+}
+
+/// The platform with its first step aborted (`execute_unliftable`) and no replans: the
+/// robot returns to the driving posture and the run stops. With `push`.
+fn aborted_platform(push: Option<Push>) -> RunSummary {
+    let opts =
+        RunOptions { max_replans: 0, push, ..RunOptions::new(plan_options(), common::model()) };
+    execute_unliftable("platform", opts).0
 }
 
 #[test]
