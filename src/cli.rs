@@ -91,6 +91,10 @@ pub enum Command {
         /// Write a Rerun recording of the maps and the path.
         #[arg(long, value_name = "FILE.rrd")]
         rerun: Option<PathBuf>,
+        /// Write a PNG of where the search went: expansions per base cell over the height
+        /// map (log scale, dark blue to magenta), also when it finds no path.
+        #[arg(long, value_name = "FILE.png")]
+        expansions: Option<PathBuf>,
         /// Print the result as JSON.
         #[arg(long)]
         json: bool,
@@ -759,14 +763,14 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             }
             Ok(true)
         }
-        Command::Plan { scenario, planner, rerun, json, detailed: true, model } => {
+        Command::Plan { scenario, planner, rerun, expansions, json, detailed: true, model } => {
             let sc = load(&scenario)?;
             let mut sim = crate::sim::Simulation::robot_only(&model.model)?;
-            let d =
-                jobs::detailed::run(&sc, &mut sim, &planner.options()).map_err(|e| match e {
-                    jobs::detailed::DetailedJobError::Plan(p) => plan_error(p),
-                    other => anyhow::Error::new(other),
-                })?;
+            let opts = jobs::plan::PlanOptions { expansion_image: expansions, ..planner.options() };
+            let d = jobs::detailed::run(&sc, &mut sim, &opts).map_err(|e| match e {
+                jobs::detailed::DetailedJobError::Plan(p) => plan_error(p),
+                other => anyhow::Error::new(other),
+            })?;
             if let Some(path) = rerun {
                 jobs::detailed::record(&sc, &d, &path)
                     .with_context(|| format!("recording {}", path.display()))?;
@@ -788,10 +792,11 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             }
             Ok(true)
         }
-        Command::Plan { scenario, planner, rerun, json, detailed: false, model } => {
+        Command::Plan { scenario, planner, rerun, expansions, json, detailed: false, model } => {
             let sc = load(&scenario)?;
             let robot = robot(&model.model)?;
-            let summary = jobs::plan::run(&sc, &robot, &planner.options()).map_err(plan_error)?;
+            let opts = jobs::plan::PlanOptions { expansion_image: expansions, ..planner.options() };
+            let summary = jobs::plan::run(&sc, &robot, &opts).map_err(plan_error)?;
             if let Some(path) = rerun {
                 jobs::plan_recording::record(&sc, &robot, &summary, &path)
                     .with_context(|| format!("recording {}", path.display()))?;

@@ -136,6 +136,36 @@ pub fn height_image(map: &HeightMap) -> Option<RgbImage> {
     })
 }
 
+/// Where a search went: the height map in dim grey (unknown olive), and every cell whose
+/// base poses the search expanded (`counts`, row-major `nx × ny`, expansions per cell) in
+/// the cost scale's colours, from 1 expansion (dark blue) to the most expanded cell
+/// (magenta) on a logarithmic scale. `None` if `counts` is not the map's size.
+pub fn expansion_image(map: &HeightMap, counts: &[u32]) -> Option<RgbImage> {
+    let grey = height_image(map)?;
+    let (nx, ny) = map.dims();
+    let top = f64::from(counts.iter().copied().max().unwrap_or(0)).max(2.0);
+    render(nx, ny, counts.len(), |k| {
+        if counts[k] > 0 {
+            cost_colour(Cost::Finite(f64::from(counts[k])), top)
+        } else {
+            let (i, j) = (k % nx, k / nx);
+            let at = ((ny - 1 - j) * nx + i) * 3;
+            let c = &grey.pixels[at..at + 3];
+            if c == UNKNOWN_RGB { UNKNOWN_RGB } else { [c[0] / 2, c[1] / 2, c[2] / 2] }
+        }
+    })
+}
+
+/// Writes [`expansion_image`].
+///
+/// # Errors
+/// `counts` is not the map's size, or the file cannot be written.
+pub fn write_expansion_png(map: &HeightMap, counts: &[u32], path: &Path) -> Result<(), ImageError> {
+    let (nx, ny) = map.dims();
+    let bad = || ImageError::BadLayer { path: path.to_path_buf(), len: counts.len(), nx, ny };
+    write_png(&expansion_image(map, counts).ok_or_else(bad)?, path)
+}
+
 /// Writes the height map in grey, unknown cells olive.
 ///
 /// # Errors
@@ -275,6 +305,35 @@ mod tests {
         assert_eq!(px(1, 0), INFINITE_RGB, "cell (0,0) is bottom-left");
         assert_eq!(px(0, 2), UNKNOWN_RGB, "cell (2,1) is top-right");
         assert_eq!(px(0, 0), [20, 20, 90]);
+    }
+
+    #[test]
+    fn expansions_are_drawn_over_the_dimmed_height_map() {
+        // 3 x 2 cells: heights 0 except (2, 0) at 1 m (white, dimmed to 127) and (0, 1)
+        // unknown; the search expanded (0, 0) once, (1, 0) 10 times, (1, 1) 100 times.
+        let mut m = HeightMap::filled([0.0, 0.0], 0.025, 3, 2, 0.0).unwrap();
+        m.set(2, 0, 1.0).unwrap();
+        m.set(0, 1, f64::NAN).unwrap();
+        let counts = [1, 10, 0, 0, 100, 0];
+        let p = tmp("expansions.png");
+        write_expansion_png(&m, &counts, &p).unwrap();
+        let (w, h, buf) = read_png(&p);
+        assert_eq!((w, h), (3, 2));
+        let px = |r: usize, c: usize| {
+            [buf[(r * 3 + c) * 3], buf[(r * 3 + c) * 3 + 1], buf[(r * 3 + c) * 3 + 2]]
+        };
+        // Log scale up to the most expanded cell: 1 → dark blue, √100 = 10 → teal,
+        // 100 → magenta (rows top to bottom are y = 1, then y = 0).
+        assert_eq!(px(1, 0), [20, 20, 90]);
+        assert_eq!(px(1, 1), [0, 150, 190]);
+        assert_eq!(px(0, 1), [220, 50, 180]);
+        // Not expanded: the height map's grey at half brightness, unknown olive.
+        assert_eq!(px(1, 2), [127, 127, 127]);
+        assert_eq!(px(0, 2), [0, 0, 0]);
+        assert_eq!(px(0, 0), UNKNOWN_RGB);
+        // A count layer not the map's size names the file.
+        let e = write_expansion_png(&m, &counts[..5], &p).unwrap_err();
+        assert!(matches!(e, ImageError::BadLayer { len: 5, nx: 3, ny: 2, .. }), "{e}");
     }
 
     #[test]

@@ -469,3 +469,45 @@ fn generate_rejects_bad_input_with_exit_code_2() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("count"));
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing written");
 }
+
+/// Width, height and the pixels that are neither grey nor olive (the expansion colours)
+/// of an RGB PNG.
+fn coloured_pixels(path: &Path) -> (u32, u32, usize) {
+    let file = std::fs::File::open(path).expect("the PNG was written");
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let coloured = buf[..info.buffer_size()]
+        .chunks(3)
+        .filter(|p| !(p[0] == p[1] && p[1] == p[2]) && *p != [128, 128, 0])
+        .count();
+    (info.width, info.height, coloured)
+}
+
+#[test]
+fn plan_draws_where_its_search_went_with_or_without_a_path() {
+    let dir = common::temp_dir("cli_expansions");
+    // A path: the expanded cells are drawn over the map (4 m × 4 m plus the r_N margin
+    // on each side, 2.5 cm cells).
+    let flat = common::root().join("scenarios/flat.toml");
+    let png = dir.join("flat.png");
+    let out = momaro(&["plan", flat.to_str().unwrap(), "--expansions", png.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let sc = common::scenario("flat");
+    let (w, h, coloured) = coloured_pixels(&png);
+    let m = &sc.map;
+    let cells = |a: f64, b: f64| ((b - a) / 0.025).round() as u32;
+    assert!(w >= cells(m.x_min, m.x_max) && h >= cells(m.y_min, m.y_max), "{w} x {h}");
+    assert!(coloured > 0, "no expanded cell drawn");
+    // No path (a closed room, proved at once): the image is still written, exit 1.
+    let room = common::root().join("scenarios/closed_room.toml");
+    let png = dir.join("room.png");
+    let out = momaro(&["plan", room.to_str().unwrap(), "--expansions", png.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(png.exists(), "no image without a path");
+    // An unwritable path names the file, exit 2 or 1, no panic.
+    let out = momaro(&["plan", flat.to_str().unwrap(), "--expansions", "/nonexistent-dir/x.png"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && stderr.contains("/nonexistent-dir/x.png"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

@@ -7,7 +7,9 @@
 //! (`locomotion::hybrid`) with A* (16-neighbourhood) or ARA* (20-neighbourhood, ε from
 //! 3 decaying to 1), as the paper does. The time limit covers everything after option
 //! checking: map and cost-map building count against it, and the search gets what is
-//! left, so a call never takes much longer than the limit.
+//! left, so a call never takes much longer than the limit. With
+//! [`PlanOptions::expansion_image`] the expansions per base cell are counted and drawn
+//! (`cost_image::expansion_image`), whether a path was found or not.
 //!
 //! Path costs are reported twice: `search_cost` as searched (with the orientation factor
 //! k_Δθ of the chosen k12) and `cost`, "the costs the path would have in the plain A*
@@ -27,8 +29,8 @@ use crate::locomotion::{
 };
 use crate::params::{FootModel, InvalidParam, Params};
 use crate::planner::{
-    Cost, Hooks, SearchError, SearchParams, SearchResult, Termination, arastar_with_hooks,
-    astar_with_hooks,
+    Cost, ExpandHook, Expansion, Hooks, SearchError, SearchParams, SearchResult, Termination,
+    arastar_with_hooks, astar_with_hooks,
 };
 use crate::robot::{Leg, RobotDescription};
 use crate::scenario::Scenario;
@@ -71,6 +73,10 @@ pub struct PlanOptions {
     /// Edges to leave out: manoeuvres the motion generator could not expand in an
     /// earlier plan of the same run (`jobs::run::plan_mission`).
     pub forbidden: Vec<(PoseKey, PoseKey)>,
+    /// Write a PNG of where the search went (`cost_image::expansion_image`: expansions
+    /// per base cell over the height map), whatever the outcome: a search that finds no
+    /// path shows where it spent its expansions. Default none.
+    pub expansion_image: Option<PathBuf>,
 }
 
 impl Default for PlanOptions {
@@ -88,6 +94,7 @@ impl Default for PlanOptions {
             foot_model: None,
             neighbourhood: None,
             forbidden: Vec::new(),
+            expansion_image: None,
         }
     }
 }
@@ -95,6 +102,12 @@ impl Default for PlanOptions {
 /// Why a plan job failed.
 #[derive(Debug, thiserror::Error)]
 pub enum PlanJobError {
+    /// The expansion image could not be written.
+    #[error(transparent)]
+    Image {
+        /// The cause (names the file).
+        source: crate::cost_image::ImageError,
+    },
     /// An option is out of range.
     #[error("invalid option `{option}`: {reason}")]
     BadOption {
@@ -560,15 +573,31 @@ impl Prepared {
     }
 }
 
-/// Runs one search on `graph`.
+/// Runs one search on `graph`; with `counts` (row-major over the lattice's cells, which
+/// are the height map's), counts the expansions of each base cell.
 fn search(
     graph: &mut HybridGraph<'_>,
     start: LatticeState,
     algorithm: Algorithm,
     params: &SearchParams,
     cancel: Option<&AtomicBool>,
+    counts: Option<&mut [u32]>,
 ) -> Result<SearchResult<LatticeState>, SearchError> {
-    let hooks = Hooks { cancel, ..Hooks::default() };
+    let nx = usize::from(graph.lattice().nx);
+    let mut count = counts.map(|c| {
+        move |e: &Expansion<LatticeState>| {
+            if let (Ok(i), Ok(j)) = (usize::try_from(e.state.i), usize::try_from(e.state.j))
+                && let Some(n) = c.get_mut(j * nx + i)
+            {
+                *n = n.saturating_add(1);
+            }
+        }
+    });
+    let hooks = Hooks {
+        cancel,
+        on_expand: count.as_mut().map(|c| c as ExpandHook<'_, LatticeState>),
+        ..Hooks::default()
+    };
     // The heuristic's lazy cost-to-go stops growing at the time limit, so a first query
     // that would reach far cannot overrun it.
     graph.set_heuristic_deadline(params.time_limit.map(|t| Instant::now() + t));
@@ -668,8 +697,17 @@ pub fn run(
         time_limit: Some(limit.saturating_sub(t0.elapsed())),
         ..SearchParams::default()
     };
-    let result = search(&mut graph, prep.start, opts.algorithm, &search_params, None)
-        .map_err(|source| PlanJobError::Search { scenario: file(), source })?;
+    let mut counts = opts.expansion_image.as_ref().map(|_| {
+        let (nx, ny) = prep.maps.heights().dims();
+        vec![0u32; nx * ny]
+    });
+    let result =
+        search(&mut graph, prep.start, opts.algorithm, &search_params, None, counts.as_deref_mut())
+            .map_err(|source| PlanJobError::Search { scenario: file(), source })?;
+    if let (Some(path), Some(c)) = (&opts.expansion_image, &counts) {
+        crate::cost_image::write_expansion_png(prep.maps.heights(), c, path)
+            .map_err(|source| PlanJobError::Image { source })?;
+    }
     let Some(best) = result.best() else {
         let reason = match result.termination {
             Termination::NoPath => {
@@ -912,7 +950,7 @@ pub fn bench(
             probe_epsilon,
             ..SearchParams::default()
         };
-        search(&mut g, prep.start, algorithm, &p, None)
+        search(&mut g, prep.start, algorithm, &p, None, None)
             .map(|r| (r, setup))
             .map_err(|source| PlanJobError::Search { scenario: file(), source })
     };
