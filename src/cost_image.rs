@@ -120,20 +120,25 @@ pub fn cost_layer_image(
 /// The height map in grey (lowest known height black, highest white), unknown olive.
 pub fn height_image(map: &HeightMap) -> Option<RgbImage> {
     let (nx, ny) = map.dims();
+    render(nx, ny, map.len(), height_colour(map))
+}
+
+/// The colour of [`height_image`] for each row-major cell of `map`.
+fn height_colour(map: &HeightMap) -> impl Fn(usize) -> [u8; 3] + '_ {
     let v = map.as_slice();
     let (lo, hi) = v
         .iter()
         .filter(|h| !h.is_nan())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &h| (lo.min(h), hi.max(h)));
     let span = if hi > lo { hi - lo } else { 1.0 };
-    render(nx, ny, v.len(), |k| {
+    move |k| {
         if v[k].is_nan() {
             UNKNOWN_RGB
         } else {
             let g = ((v[k] - lo) / span * 255.0).round().clamp(0.0, 255.0) as u8;
             [g, g, g]
         }
-    })
+    }
 }
 
 /// Where a search went: the height map in dim grey (unknown olive), and every cell whose
@@ -141,17 +146,17 @@ pub fn height_image(map: &HeightMap) -> Option<RgbImage> {
 /// the cost scale's colours, from 1 expansion (dark blue) to the most expanded cell
 /// (magenta) on a logarithmic scale. `None` if `counts` is not the map's size.
 pub fn expansion_image(map: &HeightMap, counts: &[u32]) -> Option<RgbImage> {
-    let grey = height_image(map)?;
     let (nx, ny) = map.dims();
+    let grey = height_colour(map);
     let top = f64::from(counts.iter().copied().max().unwrap_or(0)).max(2.0);
     render(nx, ny, counts.len(), |k| {
         if counts[k] > 0 {
             cost_colour(Cost::Finite(f64::from(counts[k])), top)
         } else {
-            let (i, j) = (k % nx, k / nx);
-            let at = ((ny - 1 - j) * nx + i) * 3;
-            let c = &grey.pixels[at..at + 3];
-            if c == UNKNOWN_RGB { UNKNOWN_RGB } else { [c[0] / 2, c[1] / 2, c[2] / 2] }
+            match grey(k) {
+                UNKNOWN_RGB => UNKNOWN_RGB,
+                c => c.map(|v| v / 2),
+            }
         }
     })
 }

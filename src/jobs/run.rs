@@ -22,7 +22,7 @@ use crate::control::step_executor::{
     Command, ExecEvent, ExecStatus, ExecutorConfig, Observation, StepExecutor,
 };
 use crate::geometry::{Pose2, wrap_angle};
-use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor};
+use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor, StabilitySample};
 use crate::motion::{DetailedPath, MotionError, Phase};
 use crate::progress::SimProgress;
 use crate::rng::Rng;
@@ -181,6 +181,26 @@ pub struct PushReport {
     pub negative_margin_s: f64,
     /// Largest |roll| or |pitch| in that window, degrees.
     pub max_tilt_deg: f64,
+}
+
+impl PushReport {
+    /// Whether `push` (the one this reports) has ended at `now`.
+    fn ended(&self, push: &Push, now: f64) -> bool {
+        now >= self.start_s + push.duration_s
+    }
+
+    /// Takes in a monitor `sample` at `now`, a control tick of `dt` s after the last,
+    /// while in the window (until 2 s after `push` ends).
+    fn record(&mut self, push: &Push, now: f64, sample: &StabilitySample, dt: f64) {
+        if now > self.start_s + push.duration_s + 2.0 {
+            return;
+        }
+        self.min_margin_after_m = self.min_margin_after_m.min(sample.margin);
+        if sample.margin < 0.0 {
+            self.negative_margin_s += dt;
+        }
+        self.max_tilt_deg = self.max_tilt_deg.max(sample.tilt().to_degrees());
+    }
 }
 
 /// The smallest measured margin while one step's foot was off its support (from the lift
@@ -776,7 +796,7 @@ pub fn execute(
                     });
                     sim.push_base(p.force);
                 }
-                (Some(r), _) if now >= r.start_s + p.duration_s => sim.push_base([0.0; 3]),
+                (Some(r), _) if r.ended(p, now) => sim.push_base([0.0; 3]),
                 _ => {}
             }
         }
@@ -784,15 +804,8 @@ pub fn execute(
         tick += 1;
         let sample = monitor.observe(sim);
         last_margin = sample.margin;
-        if let (Some(r), Some(p)) = (&mut push_report, &opts.push)
-            && sim.time() <= r.start_s + p.duration_s + 2.0
-        {
-            r.min_margin_after_m = r.min_margin_after_m.min(sample.margin);
-            if sample.margin < 0.0 {
-                r.negative_margin_s += control_dt;
-            }
-            let tilt = sample.roll_pitch[0].abs().max(sample.roll_pitch[1].abs());
-            r.max_tilt_deg = r.max_tilt_deg.max(tilt.to_degrees());
+        if let (Some(r), Some(p)) = (&mut push_report, &opts.push) {
+            r.record(p, sim.time(), &sample, control_dt);
         }
         if let Some(a) = exec.active_step() {
             let key = (replans, a.number);
@@ -840,20 +853,14 @@ pub fn execute(
             let (cmd, _) = exec.tick(&observe(sim, &base, truth), control_dt);
             actuate(sim, &cmd);
             if let (Some(r), Some(p)) = (&push_report, &opts.push)
-                && sim.time() >= r.start_s + p.duration_s
+                && r.ended(p, sim.time())
             {
                 sim.push_base([0.0; 3]);
             }
             sim.step(substeps)?;
             let sample = monitor.observe(sim);
-            if let (Some(r), Some(p)) = (&mut push_report, &opts.push)
-                && sim.time() <= r.start_s + p.duration_s + 2.0
-            {
-                r.min_margin_after_m = r.min_margin_after_m.min(sample.margin);
-                if sample.margin < 0.0 {
-                    r.negative_margin_s += control_dt;
-                }
-                r.max_tilt_deg = r.max_tilt_deg.max(sample.tilt().to_degrees());
+            if let (Some(r), Some(p)) = (&mut push_report, &opts.push) {
+                r.record(p, sim.time(), &sample, control_dt);
             }
             max_pitch = max_pitch.max(sim.base().rpy[1].abs());
         }
