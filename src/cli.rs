@@ -225,6 +225,11 @@ pub struct PlannerArgs {
     /// turns it off (the paper's ARA*).
     #[arg(long, allow_negative_numbers = true)]
     pub probe_epsilon: Option<f64>,
+    /// Order the probe by the admissible heuristic alone, as before its guidance (by
+    /// default every other expansion of the probe follows the heuristic without its
+    /// base-pose cost-to-go, which misleads beside open-sided stairs; for comparisons).
+    #[arg(long)]
+    pub unguided_probe: bool,
     /// Expansions ARA*'s schedule may spend once the probe has found a path, after which
     /// the probe's path is the answer (default: none for `plan`; 1000000 for `run`,
     /// `check` and `envelope`, so that their plans do not depend on the machine's speed).
@@ -264,6 +269,7 @@ impl PlannerArgs {
             time_limit_s: self.time_limit,
             initial_epsilon: self.initial_epsilon,
             probe_epsilon: self.probe_epsilon,
+            probe_guidance: !self.unguided_probe,
             schedule_expansions: self.schedule_expansions,
             final_epsilon: self.final_epsilon,
             k12: self.k12,

@@ -392,3 +392,41 @@ fn the_probe_answers_where_the_schedule_runs_out() {
     assert!((1.0..=50.0).contains(&probe.suboptimality_bound), "{}", probe.suboptimality_bound);
     assert!(!steps(&p).is_empty(), "the course is climbed");
 }
+
+/// The guided probe (issue 15, `planner::arastar` docs): generated flights with open
+/// sides (`generate --class stairs --seed 4`: 2 × 0.182 m at 106°; `--seed 11`: 6 ×
+/// 0.195 m, a landing, at −9°). The probe ordered by the admissible heuristic alone
+/// searches the floor beside the flight, where the base-pose cost-to-go is lowest but the
+/// feet cannot climb: still no path after 50,000 expansions (748 k on the first; no path
+/// in 105 s on the second). Guided, it climbs both within 5,000, and its bound still
+/// comes from the admissible heuristic.
+#[test]
+fn a_guided_probe_climbs_open_sided_stairs_its_heuristic_alone_floods_beside() {
+    for seed in [4, 11] {
+        let s = common::generated(momaro::scenario::generate::Class::Stairs, seed);
+        let probe_only = PlanOptions {
+            final_epsilon: Some(3.0),
+            schedule_expansions: Some(0),
+            max_expansions: Some(50_000),
+            ..arastar(600.0)
+        };
+        let unguided = PlanOptions { probe_guidance: false, ..probe_only.clone() };
+        let unguided = run(&s, &robot(), &unguided);
+        assert!(
+            matches!(
+                unguided,
+                Err(PlanJobError::NoPath {
+                    termination: momaro::planner::Termination::ExpansionLimit,
+                    ..
+                })
+            ),
+            "seed {seed}: {unguided:?}"
+        );
+        let p = plan(&s, &probe_only);
+        let probe = &p.solutions[0];
+        assert_eq!(probe.epsilon, 50.0, "seed {seed}");
+        assert!(probe.expansions < 5_000, "seed {seed}: {} expansions", probe.expansions);
+        assert!((1.0..=50.0).contains(&probe.suboptimality_bound), "seed {seed}");
+        assert!(steps(&p).len() >= 8, "seed {seed}: every foot climbs");
+    }
+}

@@ -52,6 +52,10 @@ pub struct PlanOptions {
     /// ε of ARA*'s greedy probe before the schedule; default
     /// `Params::arastar_probe_epsilon` (50). At most the initial ε: no probe.
     pub probe_epsilon: Option<f64>,
+    /// Whether ARA*'s probe is guided (`SearchParams::probe_guidance`: every other
+    /// expansion ordered by the heuristic without its base-pose cost-to-go,
+    /// `HeuristicParts::guidance`). Default true.
+    pub probe_guidance: bool,
     /// Expansions ARA*'s schedule may spend after its probe found a path
     /// (`SearchParams::schedule_max_expansions`): the probe's path is then the answer
     /// on any machine. Default none.
@@ -86,6 +90,7 @@ impl Default for PlanOptions {
             time_limit_s: 10.0,
             initial_epsilon: None,
             probe_epsilon: None,
+            probe_guidance: true,
             schedule_expansions: None,
             max_expansions: None,
             final_epsilon: None,
@@ -690,6 +695,7 @@ pub fn run(
     let search_params = SearchParams {
         initial_epsilon: eps0,
         probe_epsilon: probe_before(probe, eps0),
+        probe_guidance: opts.probe_guidance,
         schedule_max_expansions: opts.schedule_expansions,
         max_expansions: opts.max_expansions,
         final_epsilon: opts.final_epsilon.unwrap_or(1.0).min(eps0),
@@ -823,8 +829,10 @@ impl Default for BenchOptions {
 /// costs (with the scenario's k12), which is what the search optimises.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BenchRow {
-    /// `astar`, `arastar` (the paper's schedule alone) or `arastar+probe` (ARA* as
-    /// `plan` and `run` search: the greedy probe first, `SearchParams::probe_epsilon`).
+    /// `astar`, `arastar` (the paper's schedule alone), `arastar+probe` (ARA* as `plan`
+    /// and `run` search: the guided greedy probe first, `SearchParams::probe_epsilon`) or
+    /// `arastar+unguided` (the same with the probe ordered by the heuristic alone, as
+    /// before `SearchParams::probe_guidance`).
     pub algorithm: &'static str,
     /// `n16` or `n20`.
     pub neighbourhood: &'static str,
@@ -937,7 +945,8 @@ pub fn bench(
     let run_one = |algorithm,
                    n,
                    limit,
-                   probe_epsilon|
+                   probe_epsilon,
+                   probe_guidance|
      -> Result<(SearchResult<LatticeState>, f64), PlanJobError> {
         let mut g = prep
             .graph(robot, n, k12)
@@ -948,6 +957,7 @@ pub fn bench(
             epsilon_decay: prep.params.arastar_epsilon_decay,
             time_limit: Some(limit),
             probe_epsilon,
+            probe_guidance,
             ..SearchParams::default()
         };
         search(&mut g, prep.start, algorithm, &p, None, None)
@@ -956,24 +966,32 @@ pub fn bench(
     };
     // The repeats alternate the searches, so slow phases of a noisy machine spread over
     // all of them.
-    let (mut astar_runs, mut ara_runs, mut probe_runs) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut astar_runs, mut ara_runs) = (Vec::new(), Vec::new());
+    let (mut probe_runs, mut unguided_runs) = (Vec::new(), Vec::new());
     let probe_epsilon =
         probe_before(prep.params.arastar_probe_epsilon, prep.params.arastar_initial_epsilon);
     for _ in 0..opts.repeats {
-        let (astar16, setup16) = run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit, None)?;
+        let (astar16, setup16) =
+            run_one(Algorithm::AStar, Neighbourhood::N16, opt_limit, None, false)?;
         astar_runs.push(row("astar", "n16", &astar16, optimum_of(&astar16), &astar16, setup16));
-        let (astar20, _) = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit, None)?;
+        let (astar20, _) = run_one(Algorithm::AStar, Neighbourhood::N20, opt_limit, None, false)?;
         let optimum20 = optimum_of(&astar20);
-        let (ara, setup20) = run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit, None)?;
+        let (ara, setup20) =
+            run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit, None, false)?;
         ara_runs.push(row("arastar", "n20", &ara, optimum20, &astar20, setup20));
         if probe_epsilon.is_some() {
             let (ara, setup) =
-                run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit, probe_epsilon)?;
+                run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit, probe_epsilon, true)?;
             probe_runs.push(row("arastar+probe", "n20", &ara, optimum20, &astar20, setup));
+            let (ara, setup) =
+                run_one(Algorithm::AraStar, Neighbourhood::N20, ara_limit, probe_epsilon, false)?;
+            unguided_runs.push(row("arastar+unguided", "n20", &ara, optimum20, &astar20, setup));
         }
     }
-    let rows =
-        [astar_runs, ara_runs, probe_runs].into_iter().filter_map(BenchRow::median_of).collect();
+    let rows = [astar_runs, ara_runs, probe_runs, unguided_runs]
+        .into_iter()
+        .filter_map(BenchRow::median_of)
+        .collect();
     Ok(BenchReport { scenario: scenario.name.clone(), setup_time_s: prep.setup_time_s, rows })
 }
 

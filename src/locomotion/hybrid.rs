@@ -493,6 +493,17 @@ impl HeuristicParts {
         // Clamped at zero (feet ahead of neutral have paid in advance).
         h.saturating_sub(self.ahead)
     }
+
+    /// The guided probe's estimate (`SearchGraph::heuristic_and_guidance`):
+    /// [`Self::total`] without the cost-to-go, `driving + steps + behind − ahead`. The
+    /// cost-to-go relaxes base shifts over any edge, so it pulls the search to where the
+    /// base could be shifted onto a platform most cheaply if steps were free, such as the
+    /// open side of a flight of stairs, where the feet cannot follow; the step bound
+    /// alone, with the straight-line distance, leads to the front of the flight.
+    pub fn guidance(&self) -> Cost {
+        let without = Self { to_go: Cost::ZERO, ..*self };
+        without.total()
+    }
 }
 
 /// A lattice state by what it means, not by this graph's footprint ids: cell,
@@ -690,10 +701,11 @@ impl<'c> HybridGraph<'c> {
         p
     }
 
-    /// The heuristic of an intermediate node `p` (see [`SearchGraph::heuristic`] of
-    /// this graph); `None` if its pose has no footprint or feet on finite cells, or the
-    /// scan no foothold (the node then has no successor).
-    fn pending_heuristic(&self, p: LatticeState) -> Option<Cost> {
+    /// The heuristic and the guidance (`HeuristicParts::guidance`) of an intermediate
+    /// node `p` (see [`SearchGraph::heuristic`] of this graph); `None` if its pose has
+    /// no footprint or feet on finite cells, or the scan no foothold (the node then has
+    /// no successor).
+    fn pending_heuristic(&self, p: LatticeState) -> Option<(Cost, Cost)> {
         let k = usize::from(p.step_pending.checked_sub(1)?);
         let s = LatticeState { step_pending: 0, ..p };
         let o = self.footprints.get(s.footprint)?;
@@ -701,17 +713,17 @@ impl<'c> HybridGraph<'c> {
         let f = self.config.step_cost_factor;
         let candidates = self.step_candidates(s, &o, &feet, k);
         let charged = edge_cost(f * candidates.first()?.0);
-        let best = candidates
-            .iter()
-            .map(|&(c_s, d, _, _)| {
-                let mut o2 = o;
-                o2[k] = (i32::from(o[k]) + d) as i8;
-                // The after-step state's own heuristic: its feet as `feet_pos` places them.
-                let h = self.parts_with(s, Some((&o2, &self.feet_pos(s, &o2)))).total();
-                edge_cost(f * c_s).saturating_add(h)
-            })
-            .min()?;
-        Some(best.saturating_sub(charged))
+        let (mut best, mut guided) = (Cost::INFINITY, Cost::INFINITY);
+        for &(c_s, d, _, _) in &candidates {
+            let mut o2 = o;
+            o2[k] = (i32::from(o[k]) + d) as i8;
+            // The after-step state's own heuristic: its feet as `feet_pos` places them.
+            let parts = self.parts_with(s, Some((&o2, &self.feet_pos(s, &o2))));
+            let c = edge_cost(f * c_s);
+            best = best.min(c.saturating_add(parts.total()));
+            guided = guided.min(c.saturating_add(parts.guidance()));
+        }
+        Some((best.saturating_sub(charged), guided.saturating_sub(charged)))
     }
 
     /// Stops the heuristic's cost-to-go from growing after `deadline` (the plan's time
@@ -2160,7 +2172,17 @@ impl SearchGraph for HybridGraph<'_> {
         if s.step_pending == 0 {
             return self.heuristic_parts(s).total();
         }
-        self.pending_heuristic(s).unwrap_or(Cost::INFINITY)
+        self.pending_heuristic(s).map_or(Cost::INFINITY, |(h, _)| h)
+    }
+
+    /// The heuristic and, as guidance for ARA*'s probe, the same without the cost-to-go
+    /// (`HeuristicParts::guidance`).
+    fn heuristic_and_guidance(&self, s: LatticeState) -> (Cost, Cost) {
+        if s.step_pending == 0 {
+            let parts = self.heuristic_parts(s);
+            return (parts.total(), parts.guidance());
+        }
+        self.pending_heuristic(s).unwrap_or((Cost::INFINITY, Cost::INFINITY))
     }
 
     fn is_goal(&self, s: LatticeState) -> bool {

@@ -1117,3 +1117,24 @@ mod hybrid {
         assert_eq!(r.best().map(|s| s.cost), Some(best.cost));
     }
 }
+
+#[test]
+fn the_probes_guidance_is_the_heuristic_without_its_cost_to_go() {
+    // h = max(2, 15) + 30 + 1 − 0.5 = 45.5; guidance = 2 + 30 + 1 − 0.5 = 32.5.
+    let u = |v: f64| Cost::from_f64(v);
+    let p = HeuristicParts {
+        reachable: Cost::ZERO,
+        driving: u(2.0),
+        to_go: u(15.0),
+        steps: u(30.0),
+        behind: u(1.0),
+        ahead: u(0.5),
+    };
+    assert_eq!(p.total(), u(45.5));
+    assert_eq!(p.guidance(), u(32.5));
+    // Never above the heuristic; clamped at zero; infinite where the base cannot reach.
+    let ahead = HeuristicParts { ahead: u(40.0), ..p };
+    assert_eq!((ahead.total(), ahead.guidance()), (u(6.0), Cost::ZERO));
+    let unreachable = HeuristicParts { reachable: Cost::INFINITY, ..p };
+    assert!(unreachable.guidance().is_infinite());
+}

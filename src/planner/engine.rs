@@ -5,6 +5,14 @@
 //! A* is the same loop at ε = 1 where an improved CLOSED state is re-opened instead of
 //! being parked in INCONS (A* with re-opening, optimal for any admissible heuristic).
 //! The drivers in `astar` and `arastar` own the outer loop.
+//!
+//! **Guided search** (ARA*'s probe, `arastar` module docs): a second OPEN list ordered by
+//! `g + ε·guidance` ([`SearchGraph::heuristic_and_guidance`]) beside the first, and
+//! expansions taken from the two in turn (the alternation of Röger & Helmert, "The More,
+//! the Merrier: Combining Heuristic Estimators for Satisficing Planning", ICAPS 2010).
+//! Every OPEN state is in both lists and a state is closed whichever list it leaves by,
+//! so it is still expanded at most once per search; `g`, CLOSED, INCONS and the bound
+//! ε′ are the unguided search's, computed with the admissible heuristic.
 
 use super::nodes::{Limits, NodeId, NodeStore, path_cost, weighted_key};
 use super::open_list::{Entry, OpenList};
@@ -28,6 +36,10 @@ pub(crate) struct Engine<'g, 'h, G: SearchGraph> {
     pub graph: &'g mut G,
     pub store: NodeStore<G::State>,
     pub open: OpenList,
+    /// The guidance-ordered OPEN list of a guided search (see the module docs).
+    guide: Option<OpenList>,
+    /// The next expansion comes from `guide` (alternation).
+    guide_turn: bool,
     /// ARA*'s INCONS: states whose `g` improved after they were closed this iteration.
     pub incons: Vec<NodeId>,
     succ: Vec<(G::State, Cost)>,
@@ -62,6 +74,8 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             graph,
             store: NodeStore::new(params.max_states, dense_len),
             open: OpenList::new(),
+            guide: None,
+            guide_turn: false,
             incons: Vec::new(),
             succ: Vec::with_capacity(32),
             limits: Limits::new(params.time_limit, params.max_expansions, hooks.cancel),
@@ -92,7 +106,12 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             // empty and the search ends at once with no path.
             if goal || !h.is_infinite() {
                 n.set_open(true);
+                let guidance = n.guidance;
                 self.open.push(Entry { key: weighted_key(Cost::ZERO, h, eps), h: h.0, node: id });
+                if let Some(guide) = &mut self.guide {
+                    let key = weighted_key(Cost::ZERO, guidance, eps);
+                    guide.push(Entry { key, h: guidance.0, node: id });
+                }
             }
         }
     }
@@ -101,7 +120,16 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     /// the limits, the expansion count, the hooks and the published solutions: ARA*'s
     /// schedule after its probe.
     pub fn restart(&mut self, start: G::State, eps: u64) {
+        self.restart_with(start, eps, false);
+    }
+
+    /// [`Engine::restart`] as a guided search (module docs) if `guided`: nodes then cache
+    /// the graph's guidance and OPEN has its second, guidance-ordered list.
+    pub fn restart_with(&mut self, start: G::State, eps: u64, guided: bool) {
         self.store.clear();
+        self.store.guided = guided;
+        self.guide = guided.then(OpenList::new);
+        self.guide_turn = false;
         self.open = OpenList::new();
         self.incons.clear();
         self.goal = None;
@@ -117,9 +145,19 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
         n.in_open() && weighted_key(n.g, n.h, eps) == e.key
     }
 
+    /// Whether a guide-list entry is current: its state is still in OPEN with this
+    /// guidance key at `eps`.
+    #[inline]
+    fn is_valid_guide(store: &NodeStore<G::State>, e: &Entry, eps: u64) -> bool {
+        let n = store.get(e.node);
+        n.in_open() && weighted_key(n.g, n.guidance, eps) == e.key
+    }
+
     /// `ImprovePath()`: expand states in key order until the best goal's key is at most
     /// the smallest key in OPEN (Likhachev et al. 2003, Fig. 3, line 02), or OPEN is
-    /// empty. `Err` with the reason when a limit stops it first.
+    /// empty. `Err` with the reason when a limit stops it first. A guided search takes
+    /// every other state from its guidance-ordered list and also stops when the goal's
+    /// guidance key is at most that list's smallest.
     pub fn improve_path(&mut self) -> Result<(), Termination> {
         let eps = self.eps;
         let iter = self.iter;
@@ -128,10 +166,16 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             let Some(top) = self.open.peek_valid(|e| Self::is_valid(store, e, eps)) else {
                 return Ok(()); // OPEN = ∅
             };
+            let guided_top = self
+                .guide
+                .as_mut()
+                .and_then(|g| g.peek_valid(|e| Self::is_valid_guide(store, e, eps)));
             if let Some(goal) = self.goal {
                 let gn = self.store.get(goal);
                 // while fvalue(s_goal) > min_{s ∈ OPEN} fvalue(s)
-                if weighted_key(gn.g, gn.h, eps) <= top.key {
+                if weighted_key(gn.g, gn.h, eps) <= top.key
+                    || guided_top.is_some_and(|t| weighted_key(gn.g, gn.guidance, eps) <= t.key)
+                {
                     return Ok(());
                 }
             }
@@ -139,8 +183,19 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 return Err(t);
             }
             // line 03: remove s with the smallest fvalue from OPEN; CLOSED = CLOSED ∪ {s}
-            self.open.pop_valid(|_| true);
-            let id = top.node;
+            // (a guided search: from each list in turn)
+            let from_guide = self.guide_turn && guided_top.is_some();
+            self.guide_turn = self.guide.is_some() && !self.guide_turn;
+            let id = match (from_guide, guided_top, &mut self.guide) {
+                (true, Some(t), Some(guide)) => {
+                    guide.pop_valid(|_| true);
+                    t.node
+                }
+                _ => {
+                    self.open.pop_valid(|_| true);
+                    top.node
+                }
+            };
             let node = self.store.get_mut(id);
             node.set_open(false);
             node.close(iter);
@@ -201,8 +256,15 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 }
                 // lines 09–10: if s' ∉ CLOSED, insert/update s' in OPEN with fvalue(s')
                 tn.set_open(true);
-                let h = tn.h;
+                let (h, guidance) = (tn.h, tn.guidance);
                 self.open.push(Entry { key: weighted_key(ng, h, eps), h: h.0, node: tid });
+                if let Some(guide) = &mut self.guide {
+                    guide.push(Entry {
+                        key: weighted_key(ng, guidance, eps),
+                        h: guidance.0,
+                        node: tid,
+                    });
+                }
             }
         }
     }
@@ -253,6 +315,9 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     /// ARA*, Fig. 3 lines 10'–12': move INCONS into OPEN, re-key OPEN with the new ε,
     /// and start a new iteration (CLOSED = ∅). O(|OPEN| + |INCONS|).
     pub fn next_iteration(&mut self, new_eps: u64) {
+        // Guidance orders one search (the probe); later iterations are the paper's.
+        self.guide = None;
+        self.store.guided = false;
         let old = self.eps;
         let mut entries = self.open.take_entries();
         let store = &self.store;

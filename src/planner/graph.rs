@@ -38,6 +38,17 @@ pub trait SearchGraph {
     /// Whether `state` is a goal.
     fn is_goal(&self, state: Self::State) -> bool;
 
+    /// Optional: the admissible [`heuristic`](Self::heuristic) of `state` together with a
+    /// *guidance* estimate that orders the second OPEN list of ARA*'s greedy probe
+    /// (`arastar` module docs, "Guided probe"). Guidance need be neither admissible nor
+    /// consistent: it only chooses which state the probe expands next, and the bound the
+    /// probe certifies comes from the admissible heuristic alone. It should be zero at a
+    /// goal. The default is the heuristic itself (the second list then repeats the first).
+    fn heuristic_and_guidance(&self, state: Self::State) -> (Cost, Cost) {
+        let h = self.heuristic(state);
+        (h, h)
+    }
+
     /// Optional: whether `state` is the intermediate node of a lazily evaluated edge
     /// (default: none is). A graph may split an edge whose validity is expensive to check
     /// into a cheap edge, at a lower bound of its cost, to an intermediate node, and the
@@ -87,6 +98,10 @@ impl<G: SearchGraph + ?Sized> SearchGraph for &mut G {
 
     fn is_goal(&self, state: Self::State) -> bool {
         (**self).is_goal(state)
+    }
+
+    fn heuristic_and_guidance(&self, state: Self::State) -> (Cost, Cost) {
+        (**self).heuristic_and_guidance(state)
     }
 
     fn is_intermediate(&self, state: Self::State) -> bool {

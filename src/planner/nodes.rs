@@ -2,8 +2,8 @@
 //! `Vec` of compact node records, a deterministic Fx-style hasher, the limit checks
 //! (time, cancel, expansions) and path reconstruction.
 //!
-//! A node record is the state plus 24 bytes (`g`, cached `h`, parent id, and a packed
-//! word holding the CLOSED iteration and the OPEN / INCONS / goal flags), so ARA*'s
+//! A node record is the state plus 32 bytes (`g`, cached `h` and guidance, parent id, and
+//! a packed word holding the CLOSED iteration and the OPEN / INCONS / goal flags), so ARA*'s
 //! "CLOSED = ∅" at the start of each iteration is O(1): a state is closed only if it was
 //! closed *in the current iteration*.
 
@@ -115,6 +115,9 @@ pub(crate) struct Node<S> {
     pub g: Cost,
     /// Cached heuristic.
     pub h: Cost,
+    /// Cached guidance ([`SearchGraph::heuristic_and_guidance`]) in a guided store, else
+    /// equal to `h`.
+    pub guidance: Cost,
     /// Predecessor on the best known path.
     pub parent: NodeId,
     /// Bits 0–28: iteration + 1 in which the node was last closed (0: never);
@@ -182,6 +185,8 @@ pub(crate) struct NodeStore<S> {
     dense: Vec<u32>,
     pub nodes: Vec<Node<S>>,
     limit: usize,
+    /// Whether new nodes ask the graph for their guidance (a guided probe runs).
+    pub guided: bool,
 }
 
 impl<S: Copy + Eq + std::hash::Hash> NodeStore<S> {
@@ -193,6 +198,7 @@ impl<S: Copy + Eq + std::hash::Hash> NodeStore<S> {
             dense: vec![0; dense_len],
             nodes: Vec::new(),
             limit: max_states.map_or(cap, |m| m.min(cap)),
+            guided: false,
         }
     }
 
@@ -213,13 +219,13 @@ impl<S: Copy + Eq + std::hash::Hash> NodeStore<S> {
         }
         let id = self.nodes.len() as NodeId;
         let meta = if graph.is_goal(state) { GOAL } else { 0 };
-        self.nodes.push(Node {
-            state,
-            g: Cost::INFINITY,
-            h: graph.heuristic(state),
-            parent: NO_NODE,
-            meta,
-        });
+        let (h, guidance) = if self.guided {
+            graph.heuristic_and_guidance(state)
+        } else {
+            let h = graph.heuristic(state);
+            (h, h)
+        };
+        self.nodes.push(Node { state, g: Cost::INFINITY, h, guidance, parent: NO_NODE, meta });
         Some(id)
     }
 
@@ -395,7 +401,14 @@ mod tests {
 
     #[test]
     fn meta_bits_are_independent() {
-        let mut n = Node { state: (), g: Cost::ZERO, h: Cost::ZERO, parent: NO_NODE, meta: GOAL };
+        let mut n = Node {
+            state: (),
+            g: Cost::ZERO,
+            h: Cost::ZERO,
+            guidance: Cost::ZERO,
+            parent: NO_NODE,
+            meta: GOAL,
+        };
         n.set_open(true);
         n.close(7);
         n.set_incons(true);

@@ -20,6 +20,10 @@ pub struct SearchParams {
     /// its bound ε′ and kept as the answer should a limit stop the schedule, which then
     /// starts from scratch (`arastar`). Not in the paper.
     pub probe_epsilon: Option<f64>,
+    /// ARA*: whether the probe is guided: every other expansion taken from a second OPEN
+    /// list ordered by the graph's guidance (`SearchGraph::heuristic_and_guidance`,
+    /// `arastar` module docs). Not in the paper; the bound it certifies is unchanged.
+    pub probe_guidance: bool,
     /// ARA*: ε of the last search (≥ 1, ≤ `initial_epsilon`). 1.0 proves optimality.
     pub final_epsilon: f64,
     /// ARA*: after each solution, `ε − final_epsilon` is multiplied by this factor
@@ -48,6 +52,7 @@ impl Default for SearchParams {
         Self {
             initial_epsilon: 3.0,
             probe_epsilon: None,
+            probe_guidance: true,
             final_epsilon: 1.0,
             epsilon_decay: 0.5,
             epsilon_snap: 0.01,

@@ -15,6 +15,8 @@ struct Table {
     edges: Vec<(u8, u8, u64)>,
     h: Vec<u64>,
     goal: u8,
+    /// Guidance per state (`SearchGraph::heuristic_and_guidance`); none: the heuristic.
+    guidance: Option<Vec<u64>>,
 }
 
 impl SearchGraph for Table {
@@ -32,6 +34,10 @@ impl SearchGraph for Table {
     fn is_goal(&self, s: u8) -> bool {
         s == self.goal
     }
+    fn heuristic_and_guidance(&self, s: u8) -> (Cost, Cost) {
+        let h = self.heuristic(s);
+        (h, self.guidance.as_ref().map_or(h, |g| Cost(g[s as usize] * Cost::SCALE)))
+    }
 }
 
 const S: u8 = 0;
@@ -42,7 +48,12 @@ const G: u8 = 3;
 /// S→A→G costs 6, S→B→G costs 4. h is consistent but badly underestimates at A, so
 /// weighted A* (ε = 3) takes the route through A; ARA* must then improve it.
 fn trap() -> Table {
-    Table { edges: vec![(S, A, 1), (A, G, 5), (S, B, 3), (B, G, 1)], h: vec![1, 0, 1, 0], goal: G }
+    Table {
+        edges: vec![(S, A, 1), (A, G, 5), (S, B, 3), (B, G, 1)],
+        h: vec![1, 0, 1, 0],
+        goal: G,
+        guidance: None,
+    }
 }
 
 fn units(c: u64) -> Cost {
@@ -85,6 +96,34 @@ fn a_probe_publishes_first_and_the_schedule_still_finds_the_optimum() {
     assert_eq!(r.best().expect("solution").path, vec![S, B, G]);
     // ε′ of the probe's path: 6 / min(g + h over OPEN) = 6 / (3 + 1).
     assert!((r.solutions[0].suboptimality_bound - 1.5).abs() < 1e-12);
+}
+
+#[test]
+fn a_guided_probe_takes_the_route_its_guidance_shows() {
+    // Guidance that knows A is a detour: the probe expands S from the heuristic's list,
+    // then B from the guidance's (key 3 + 10·0 against A's 1 + 10·100), and stops at G
+    // (guidance key 4, the guidance list's smallest). Its bound comes from the admissible
+    // heuristic: ε′ = 4 / min(g + h over OPEN) = 4 / (1 + 0), A being still open.
+    let mut guided = trap();
+    guided.guidance = Some(vec![1, 100, 0, 0]);
+    let p = SearchParams {
+        probe_epsilon: Some(10.0),
+        initial_epsilon: 3.0,
+        final_epsilon: 3.0,
+        schedule_max_expansions: Some(0),
+        ..SearchParams::default()
+    };
+    let r = arastar(&mut guided, S, &p).expect("valid params");
+    let probe = &r.solutions[0];
+    assert_eq!((probe.path.clone(), probe.cost, probe.epsilon), (vec![S, B, G], units(4), 10.0));
+    assert!((probe.suboptimality_bound - 4.0).abs() < 1e-12, "{}", probe.suboptimality_bound);
+    // Unguided, the probe falls into the trap (S, A, G: cost 6).
+    let r = arastar(&mut guided, S, &SearchParams { probe_guidance: false, ..p.clone() })
+        .expect("valid params");
+    assert_eq!((r.solutions[0].path.clone(), r.solutions[0].cost), (vec![S, A, G], units(6)));
+    // Guidance equal to the heuristic (the default) searches as the unguided probe does.
+    let r = arastar(&mut trap(), S, &p).expect("valid params");
+    assert_eq!((r.solutions[0].path.clone(), r.solutions[0].cost), (vec![S, A, G], units(6)));
 }
 
 #[test]
@@ -154,6 +193,7 @@ fn astar_reopens_for_inconsistent_admissible_heuristic() {
         edges: vec![(S, A, 6), (S, B, 2), (B, A, 2), (A, G, 10), (S, C, 15), (C, G, 0)],
         h: vec![0, 0, 12, 0, 0],
         goal: G,
+        guidance: None,
     };
     let r = astar(&mut g, S, &SearchParams::default());
     let best = r.best().expect("solution");
@@ -174,7 +214,12 @@ fn start_is_goal() {
 
 #[test]
 fn unreachable_goal_reports_no_path() {
-    let mut g = Table { edges: vec![(S, A, 1), (A, S, 1), (B, G, 1)], h: vec![0; 4], goal: G };
+    let mut g = Table {
+        edges: vec![(S, A, 1), (A, S, 1), (B, G, 1)],
+        h: vec![0; 4],
+        goal: G,
+        guidance: None,
+    };
     let r = astar(&mut g, S, &SearchParams::default());
     assert_eq!(r.termination, Termination::NoPath);
     assert!(r.solutions.is_empty());
@@ -377,6 +422,30 @@ fn grid_strategy() -> impl Strategy<Value = (Grid, (i32, i32))> {
         })
 }
 
+/// A [`Grid`] with an arbitrary guidance per cell (row-major, in cells of `STRAIGHT`).
+#[derive(Debug, Clone)]
+struct Guided {
+    grid: Grid,
+    guidance: Vec<u64>,
+}
+
+impl SearchGraph for Guided {
+    type State = (i32, i32);
+    fn successors(&mut self, s: (i32, i32), out: &mut Vec<((i32, i32), Cost)>) {
+        self.grid.successors(s, out);
+    }
+    fn heuristic(&self, s: (i32, i32)) -> Cost {
+        self.grid.heuristic(s)
+    }
+    fn is_goal(&self, s: (i32, i32)) -> bool {
+        self.grid.is_goal(s)
+    }
+    fn heuristic_and_guidance(&self, s: (i32, i32)) -> (Cost, Cost) {
+        let k = (s.1 * self.grid.w + s.0) as usize % self.guidance.len();
+        (self.grid.heuristic(s), Cost(self.guidance[k] * STRAIGHT))
+    }
+}
+
 fn eps_params(initial: f64, decay: f64) -> SearchParams {
     SearchParams { initial_epsilon: initial, epsilon_decay: decay, ..SearchParams::default() }
 }
@@ -441,6 +510,34 @@ proptest! {
             .best()
             .map(|s| s.cost);
         prop_assert_eq!(Some(last.cost), astar_cost);
+    }
+
+    #[test]
+    fn a_guided_probe_keeps_arastars_bounds_whatever_its_guidance(
+        (grid, start) in grid_strategy(),
+        guidance in proptest::collection::vec(0u64..40, 196),
+        probe in 3.5f64..60.0,
+    ) {
+        // Guidance of any size, unrelated to the costs: the probe's order changes, the
+        // bounds do not (ε′ from the admissible heuristic), and the schedule still ends
+        // at the optimum.
+        let optimal = dijkstra(&mut grid.clone(), start);
+        let mut g = Guided { grid: grid.clone(), guidance };
+        let p = SearchParams { probe_epsilon: Some(probe), ..eps_params(3.0, 0.5) };
+        let r = arastar(&mut g, start, &p).expect("valid");
+        let Some(opt) = optimal else {
+            prop_assert_eq!(r.termination, Termination::NoPath);
+            return Ok(());
+        };
+        prop_assert_eq!(r.termination, Termination::OptimalProven);
+        for sol in &r.solutions {
+            assert_valid_path(&mut g.grid, start, sol);
+            let eps_milli = (sol.epsilon * 1000.0).round() as u128;
+            prop_assert!(u128::from(sol.cost.0) * 1000 <= eps_milli * u128::from(opt.0));
+            prop_assert!(sol.cost.to_f64() <= sol.suboptimality_bound * opt.to_f64() * (1.0 + 1e-9));
+            prop_assert!(sol.suboptimality_bound >= 1.0 && sol.suboptimality_bound <= sol.epsilon);
+        }
+        prop_assert_eq!(r.best().map(|s| s.cost), Some(opt));
     }
 
     #[test]
