@@ -69,6 +69,20 @@ fn mean_drive_angle(p: &PlanSummary) -> f64 {
     if len > 0.0 { sum / len } else { 0.0 }
 }
 
+/// A plan that found no path before its expansion cap stopped it.
+fn assert_stopped_by_expansion_limit(result: &Result<PlanSummary, PlanJobError>, what: &str) {
+    assert!(
+        matches!(
+            result,
+            Err(PlanJobError::NoPath {
+                termination: momaro::planner::Termination::ExpansionLimit,
+                ..
+            })
+        ),
+        "{what}: {result:?}"
+    );
+}
+
 fn check_solutions(p: &PlanSummary) {
     assert!(!p.solutions.is_empty());
     for w in p.solutions.windows(2) {
@@ -372,17 +386,7 @@ fn the_probe_answers_where_the_schedule_runs_out() {
     };
     let paper =
         PlanOptions { probe_epsilon: Some(3.0), max_expansions: Some(100_000), ..capped.clone() };
-    let paper = run(&s, &robot(), &paper);
-    assert!(
-        matches!(
-            paper,
-            Err(PlanJobError::NoPath {
-                termination: momaro::planner::Termination::ExpansionLimit,
-                ..
-            })
-        ),
-        "{paper:?}"
-    );
+    assert_stopped_by_expansion_limit(&run(&s, &robot(), &paper), "the paper's ARA*");
     let p = plan(&s, &capped);
     assert_eq!(p.termination, "expansion_limit");
     assert_eq!(p.solutions.len(), 1);
@@ -411,17 +415,7 @@ fn a_guided_probe_climbs_open_sided_stairs_its_heuristic_alone_floods_beside() {
             ..arastar(600.0)
         };
         let unguided = PlanOptions { probe_guidance: false, ..probe_only.clone() };
-        let unguided = run(&s, &robot(), &unguided);
-        assert!(
-            matches!(
-                unguided,
-                Err(PlanJobError::NoPath {
-                    termination: momaro::planner::Termination::ExpansionLimit,
-                    ..
-                })
-            ),
-            "seed {seed}: {unguided:?}"
-        );
+        assert_stopped_by_expansion_limit(&run(&s, &robot(), &unguided), &format!("seed {seed}"));
         let p = plan(&s, &probe_only);
         let probe = &p.solutions[0];
         assert_eq!(probe.epsilon, 50.0, "seed {seed}");
