@@ -35,8 +35,9 @@
 //! cost-to-go lets a relaxed base shift over any edge, so beside a flight of stairs with
 //! open sides it is lower than in front of it, and a probe ordered by it alone searched
 //! the whole floor at every heading (1.6 M expansions) before it stepped onto a two-step
-//! flight its guidance (the same heuristic without that term) climbs in 140. Alternating
-//! costs at most about twice the expansions of the better list. ε′ is certified as
+//! flight its guidance (the same heuristic without that term) climbs in 140. Where the
+//! heuristic alone was the better guide, alternating costs expansions (a generated mixed
+//! course: 170 → 1,041). ε′ is certified as
 //! before, from the admissible heuristic over OPEN and INCONS, which holds whatever order
 //! the states were expanded in.
 //!

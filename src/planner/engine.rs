@@ -107,11 +107,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             if goal || !h.is_infinite() {
                 n.set_open(true);
                 let guidance = n.guidance;
-                self.open.push(Entry { key: weighted_key(Cost::ZERO, h, eps), h: h.0, node: id });
-                if let Some(guide) = &mut self.guide {
-                    let key = weighted_key(Cost::ZERO, guidance, eps);
-                    guide.push(Entry { key, h: guidance.0, node: id });
-                }
+                push_open(&mut self.open, self.guide.as_mut(), id, Cost::ZERO, h, guidance, eps);
             }
         }
     }
@@ -257,14 +253,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 // lines 09–10: if s' ∉ CLOSED, insert/update s' in OPEN with fvalue(s')
                 tn.set_open(true);
                 let (h, guidance) = (tn.h, tn.guidance);
-                self.open.push(Entry { key: weighted_key(ng, h, eps), h: h.0, node: tid });
-                if let Some(guide) = &mut self.guide {
-                    guide.push(Entry {
-                        key: weighted_key(ng, guidance, eps),
-                        h: guidance.0,
-                        node: tid,
-                    });
-                }
+                push_open(&mut self.open, self.guide.as_mut(), tid, ng, h, guidance, eps);
             }
         }
     }
@@ -357,6 +346,24 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     /// Whether the start could be stored at all.
     pub fn started(&self) -> bool {
         self.store.len() > 0
+    }
+}
+
+/// Inserts node `id` (cost `g`, heuristic `h`, guidance `guidance`) into OPEN at ε
+/// `eps`, and into the guidance-ordered list of a guided search.
+#[inline]
+fn push_open(
+    open: &mut OpenList,
+    guide: Option<&mut OpenList>,
+    id: NodeId,
+    g: Cost,
+    h: Cost,
+    guidance: Cost,
+    eps: u64,
+) {
+    open.push(Entry { key: weighted_key(g, h, eps), h: h.0, node: id });
+    if let Some(guide) = guide {
+        guide.push(Entry { key: weighted_key(g, guidance, eps), h: guidance.0, node: id });
     }
 }
 
