@@ -293,6 +293,14 @@ fn steep_stairs_whole_mission_in_closed_loop() {
 }
 
 #[test]
+fn long_stairs_whole_mission_in_closed_loop() {
+    // Six 0.17 m rises on 0.29 m treads, open sides: a flight longer than the robot, on
+    // which for most of the climb every foot stands on a different step.
+    let s = run_whole("stairs_long");
+    assert!(s.steps_planned >= 20, "{}", s.steps_planned);
+}
+
+#[test]
 fn stairwell_whole_mission_in_closed_loop() {
     // Four 0.17 m rises on 0.29 m treads between walls: a flight longer than the robot's
     // feet span. The planner searched every reachable pose without a path: with the
