@@ -295,7 +295,7 @@ fn steep_stairs_whole_mission_in_closed_loop() {
 #[test]
 fn long_stairs_whole_mission_in_closed_loop() {
     // Six 0.17 m rises on 0.29 m treads, open sides: a flight longer than the robot, on
-    // which for most of the climb every foot stands on a different step.
+    // which for most of the climb the front and rear feet stand on different steps.
     let s = run_whole("stairs_long");
     assert!(s.steps_planned >= 20, "{}", s.steps_planned);
 }
