@@ -64,23 +64,117 @@ pub const FEET_REACH_M: f64 = 1.0;
 /// Link radius between admissible cells, cells.
 pub const LINK_CELLS: isize = 2;
 
-/// A fixed-size bit set: one bit per (cell, orientation), 32 MB at the 4 M-cell map
-/// limit with 64 orientations.
-struct Bits(Vec<u64>);
+/// Most words a cell's orientation set takes: the lattice has at most 256 orientations.
+const MAX_WORDS: usize = 4;
 
-impl Bits {
-    fn new(n: usize) -> Self {
-        Self(vec![0; n.div_ceil(64)])
+/// One cell's set of orientations, bit o of word o / 64.
+type Mask = [u64; MAX_WORDS];
+
+/// A set of orientations per cell (one bit per (cell, orientation), cell by cell in
+/// whole words: 32 MB at the 4 M-cell map limit with 64 orientations), so that the flood
+/// moves all orientations of a cell at once.
+struct OrientationSets {
+    words: usize,
+    orientations: usize,
+    bits: Vec<u64>,
+}
+
+impl OrientationSets {
+    fn new(cells: usize, orientations: usize) -> Self {
+        let words = orientations.div_ceil(64).clamp(1, MAX_WORDS);
+        Self { words, orientations, bits: vec![0; cells * words] }
+    }
+
+    #[cfg(test)]
+    fn get(&self, k: usize, o: usize) -> bool {
+        self.bits[k * self.words + o / 64] >> (o % 64) & 1 == 1
     }
 
     #[inline]
-    fn get(&self, k: usize) -> bool {
-        self.0[k / 64] >> (k % 64) & 1 == 1
+    fn set(&mut self, k: usize, o: usize) {
+        self.bits[k * self.words + o / 64] |= 1 << (o % 64);
     }
 
     #[inline]
-    fn set(&mut self, k: usize) {
-        self.0[k / 64] |= 1 << (k % 64);
+    fn mask(&self, k: usize) -> Mask {
+        let mut m = [0; MAX_WORDS];
+        m[..self.words].copy_from_slice(&self.bits[k * self.words..(k + 1) * self.words]);
+        m
+    }
+
+    #[inline]
+    fn any(&self, k: usize) -> bool {
+        self.bits[k * self.words..(k + 1) * self.words].iter().any(|&w| w != 0)
+    }
+
+    /// Adds to cell `k` the orientations of `new` that `ok` admits there, and every
+    /// orientation of `ok` joined to them by turns on the spot (cyclic neighbours);
+    /// whether any was new.
+    fn spread(&mut self, k: usize, new: &Mask, ok: &Self) -> bool {
+        let (words, n) = (self.words, self.orientations);
+        let allowed = ok.mask(k);
+        let mut mine = self.mask(k);
+        let mut grow: Mask = std::array::from_fn(|w| new[w] & allowed[w] & !mine[w]);
+        if grow.iter().all(|&w| w == 0) {
+            return false;
+        }
+        while grow.iter().any(|&w| w != 0) {
+            for w in 0..words {
+                mine[w] |= grow[w];
+            }
+            let turned = turns(&mine, words, n);
+            grow = std::array::from_fn(|w| turned[w] & allowed[w] & !mine[w]);
+        }
+        self.bits[k * words..(k + 1) * words].copy_from_slice(&mine[..words]);
+        true
+    }
+}
+
+/// The orientations one turn (±1, cyclic over `n`) from those of `m` (`words` words).
+fn turns(m: &Mask, words: usize, n: usize) -> Mask {
+    let bit = |o: usize| m[o / 64] >> (o % 64) & 1;
+    // Up by one: shift with carry, the top orientation wraps to 0; down likewise.
+    let mut up = [0; MAX_WORDS];
+    let mut down = [0; MAX_WORDS];
+    for w in 0..words {
+        up[w] = m[w] << 1 | if w > 0 { m[w - 1] >> 63 } else { 0 };
+        down[w] = m[w] >> 1 | if w + 1 < words { m[w + 1] << 63 } else { 0 };
+    }
+    up[0] |= bit(n - 1);
+    down[(n - 1) / 64] |= bit(0) << ((n - 1) % 64);
+    // Clear bits at or past n (shifted in from the last orientation).
+    let mut out = [0; MAX_WORDS];
+    for w in 0..words {
+        let valid = if (w + 1) * 64 <= n { u64::MAX } else { (1u64 << (n - w * 64)) - 1 };
+        out[w] = (up[w] | down[w]) & valid;
+    }
+    out
+}
+
+/// Cells probed by the admissibility tests of one orientation, as shifts (along x, along
+/// y) from the cell tested.
+struct Probes {
+    /// The base circles' centres.
+    body: [(isize, isize); 2],
+    /// Per hip, the points of its sagittal band (see `HIP_BAND_*`).
+    hip_bands: [[(isize, isize); HIP_BAND_X.len() * HIP_BAND_Y.len()]; 4],
+}
+
+impl Probes {
+    fn new(robot: &RobotDescription, circle_radius_m: f64, yaw: f64, res: f64) -> Self {
+        let (s, c) = yaw.sin_cos();
+        let shift = |x: f64, y: f64| {
+            let cells = |d: f64| (0.5 + d / res).floor() as isize;
+            (cells(c * x - s * y), cells(s * x + c * y))
+        };
+        let body = robot.base_circle_centres_x(circle_radius_m).map(|cx| shift(cx, 0.0));
+        let hip_bands = robot.hips.map(|hp| {
+            std::array::from_fn(|n| {
+                let (dx, dy) = (HIP_BAND_X[n / HIP_BAND_Y.len()], HIP_BAND_Y[n % HIP_BAND_Y.len()]);
+                shift(hp[0] - hp[0].signum() * dx, hp[1] + dy)
+            })
+        });
+        Self { body, hip_bands }
     }
 }
 
@@ -111,62 +205,11 @@ impl BaseRegions {
         circle_radius_m: f64,
         goal: (i16, i16),
     ) -> Self {
-        let hm = maps.heights();
-        let (nx, ny) = hm.dims();
-        let res = hm.resolution();
-        // Highest standable ground near each cell (a square window holding the disc of
-        // FEET_REACH_M: a larger window only weakens the test); not standable = unknown.
-        let standable: Vec<f64> = (0..nx * ny)
-            .map(|k| match (maps.foot_cost_cell(k % nx, k / nx).finite(), hm.as_slice()[k]) {
-                (Some(_), h) if h.is_finite() => h,
-                _ => f64::NAN,
-            })
-            .collect();
-        let Ok(standable) = HeightMap::new(hm.origin(), res, nx, ny, standable) else {
+        let Some(ok) = admissible(maps, robot, lattice, circle_radius_m) else {
             return Self::off();
         };
-        let h_loc = standable.dilated_max((FEET_REACH_M / res).ceil() as usize);
-        let h_loc = h_loc.as_slice();
-        let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
-        let legs = maps.leg_terrain();
-        let circles = robot.base_circle_centres_x(circle_radius_m);
-        let trig: Vec<(f64, f64)> =
-            (0..lattice.orientations).map(|k| lattice.yaw(k as u8).sin_cos()).collect();
-        let cell = |x: f64, y: f64| hm.cell_of(x, y);
+        let (nx, ny) = maps.heights().dims();
         let no = usize::from(lattice.orientations);
-        let admissible = |k: usize, o: usize| -> bool {
-            let (i, j) = (k % nx, k / nx);
-            let top = h_loc[k];
-            if !top.is_finite() {
-                return false;
-            }
-            let (x, y) =
-                (hm.origin()[0] + (i as f64 + 0.5) * res, hm.origin()[1] + (j as f64 + 0.5) * res);
-            let (s, c) = trig[o];
-            let body_ok = circles.iter().all(|&cx| {
-                cell(x + c * cx, y + s * cx)
-                    .and_then(|(a, b)| body.get(a, b))
-                    .is_some_and(|h| h <= top + BODY_RISE_M)
-            });
-            body_ok
-                && robot.hips.iter().all(|hp| {
-                    // Somewhere in the hip's sagittal band (see `HIP_BAND_*`).
-                    HIP_BAND_X.iter().any(|dx| {
-                        HIP_BAND_Y.iter().any(|dy| {
-                            let (bx, by) = (hp[0] - hp[0].signum() * dx, hp[1] + dy);
-                            // Unknown or off the map: `legs_clear` lets it pass too.
-                            legs.height_at_cell(x + c * bx - s * by, y + s * bx + c * by)
-                                .is_none_or(|h| h <= top + HIP_RISE_M)
-                        })
-                    })
-                })
-        };
-        let mut ok = Bits::new(nx * ny * no);
-        for n in 0..nx * ny * no {
-            if admissible(n / no, n % no) {
-                ok.set(n);
-            }
-        }
         let Some(g) = (|| {
             let (i, j) = (usize::try_from(goal.0).ok()?, usize::try_from(goal.1).ok()?);
             (i < nx && j < ny).then_some(j * nx + i)
@@ -175,45 +218,28 @@ impl BaseRegions {
         };
         // Flood from the goal cell's admissible orientations: linked are the same
         // orientation at most LINK_CELLS away along each axis, and the neighbouring
-        // orientations in the same cell (a turn on the spot).
-        let mut seen = Bits::new(nx * ny * no);
-        let mut queue: Vec<usize> = (0..no).map(|o| g * no + o).filter(|&n| ok.get(n)).collect();
-        if queue.is_empty() {
+        // orientations in the same cell (a turn on the spot). A cell's orientations move
+        // together, as one set; a cell is queued whenever it gains some.
+        let mut seen = OrientationSets::new(nx * ny, no);
+        if !seen.spread(g, &ok.mask(g), &ok) {
             return Self::off();
         }
-        for &n in &queue {
-            seen.set(n);
-        }
-        while let Some(n) = queue.pop() {
-            let (k, o) = (n / no, n % no);
+        let mut queue = vec![g];
+        while let Some(k) = queue.pop() {
+            let from = seen.mask(k);
             let (i, j) = ((k % nx) as isize, (k / nx) as isize);
-            for o2 in [(o + 1) % no, (o + no - 1) % no] {
-                let m = k * no + o2;
-                if ok.get(m) && !seen.get(m) {
-                    seen.set(m);
-                    queue.push(m);
-                }
-            }
             for b in (j - LINK_CELLS).max(0)..=(j + LINK_CELLS).min(ny as isize - 1) {
                 for a in (i - LINK_CELLS).max(0)..=(i + LINK_CELLS).min(nx as isize - 1) {
-                    let m = (b as usize * nx + a as usize) * no + o;
-                    if ok.get(m) && !seen.get(m) {
-                        seen.set(m);
-                        queue.push(m);
+                    let k2 = b as usize * nx + a as usize;
+                    if seen.spread(k2, &from, &ok) {
+                        queue.push(k2);
                     }
                 }
             }
         }
         // Per cell: reaches the goal with some orientation, cannot, or not admissible.
-        let region: Vec<u32> = (0..nx * ny)
-            .map(|k| {
-                if (0..no).any(|o| ok.get(k * no + o)) {
-                    u32::from(!(0..no).any(|o| seen.get(k * no + o)))
-                } else {
-                    NONE
-                }
-            })
-            .collect();
+        let region: Vec<u32> =
+            (0..nx * ny).map(|k| if ok.any(k) { u32::from(!seen.any(k)) } else { NONE }).collect();
         let regions = 1 + usize::from(region.contains(&1));
         Self { nx, goal_region: Some(0), region, regions }
     }
@@ -235,6 +261,73 @@ impl BaseRegions {
     pub fn is_on(&self) -> bool {
         self.goal_region.is_some()
     }
+}
+
+/// The admissible (cell, orientation) pairs (see the module's doc); `None` if the map
+/// cannot be scanned.
+fn admissible(
+    maps: &CostMaps,
+    robot: &RobotDescription,
+    lattice: &Lattice,
+    circle_radius_m: f64,
+) -> Option<OrientationSets> {
+    let hm = maps.heights();
+    let (nx, ny) = hm.dims();
+    let res = hm.resolution();
+    // Highest standable ground near each cell (a square window holding the disc of
+    // FEET_REACH_M: a larger window only weakens the test); not standable = unknown.
+    let standable: Vec<f64> = (0..nx * ny)
+        .map(|k| match (maps.foot_cost_cell(k % nx, k / nx).finite(), hm.as_slice()[k]) {
+            (Some(_), h) if h.is_finite() => h,
+            _ => f64::NAN,
+        })
+        .collect();
+    let standable = HeightMap::new(hm.origin(), res, nx, ny, standable).ok()?;
+    let h_loc = standable.dilated_max((FEET_REACH_M / res).ceil() as usize);
+    let h_loc = h_loc.as_slice();
+    let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
+    let legs = maps.leg_terrain();
+    let no = usize::from(lattice.orientations);
+    // Every probe of the tests, per orientation, as a whole-cell shift from the cell
+    // tested: a point d from a cell's centre lies in the cell floor(0.5 + d / res)
+    // away, the same for every cell, so the scan below does integer look-ups only.
+    let probes: Vec<Probes> =
+        (0..no).map(|o| Probes::new(robot, circle_radius_m, lattice.yaw(o as u8), res)).collect();
+    let shifted = |i: usize, j: usize, (di, dj): (isize, isize)| {
+        let (a, b) = (i.checked_add_signed(di)?, j.checked_add_signed(dj)?);
+        (a < nx && b < ny).then_some((a, b))
+    };
+    let mut ok = OrientationSets::new(nx * ny, no);
+    for j in 0..ny {
+        for i in 0..nx {
+            let k = j * nx + i;
+            let top = h_loc[k];
+            if !top.is_finite() {
+                continue;
+            }
+            for (o, probe) in probes.iter().enumerate() {
+                let body_ok = probe.body.iter().all(|&d| {
+                    shifted(i, j, d)
+                        .and_then(|(a, b)| body.get(a, b))
+                        .is_some_and(|h| h <= top + BODY_RISE_M)
+                });
+                // Unknown or off the map: `legs_clear` lets it pass too.
+                let legs_ok = || {
+                    probe.hip_bands.iter().all(|band| {
+                        band.iter().any(|&d| {
+                            shifted(i, j, d)
+                                .and_then(|(a, b)| legs.get(a, b))
+                                .is_none_or(|h| h <= top + HIP_RISE_M)
+                        })
+                    })
+                };
+                if body_ok && legs_ok() {
+                    ok.set(k, o);
+                }
+            }
+        }
+    }
+    Some(ok)
 }
 
 #[cfg(test)]
@@ -309,5 +402,153 @@ mod tests {
         ];
         let (r, l) = regions(&prims, [4.5, 0.0]);
         assert!(goal_reachable(&r, &l, [0.0, 0.0]));
+    }
+
+    /// The admissibility test as the module's doc states it, in world coordinates: each
+    /// probe point rotated by the orientation's yaw from the cell's centre and looked up
+    /// in the map's cell that holds it.
+    fn admissible_by_definition(
+        maps: &CostMaps,
+        robot: &RobotDescription,
+        lattice: &Lattice,
+    ) -> Vec<bool> {
+        let hm = maps.heights();
+        let (nx, ny) = hm.dims();
+        let res = hm.resolution();
+        let standable: Vec<f64> = (0..nx * ny)
+            .map(|k| match (maps.foot_cost_cell(k % nx, k / nx).finite(), hm.as_slice()[k]) {
+                (Some(_), h) if h.is_finite() => h,
+                _ => f64::NAN,
+            })
+            .collect();
+        let standable = HeightMap::new(hm.origin(), res, nx, ny, standable).unwrap();
+        let h_loc = standable.dilated_max((FEET_REACH_M / res).ceil() as usize);
+        let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
+        let legs = maps.leg_terrain();
+        let no = usize::from(lattice.orientations);
+        let mut out = vec![false; nx * ny * no];
+        for (n, out) in out.iter_mut().enumerate() {
+            let (k, o) = (n / no, n % no);
+            let top = h_loc.as_slice()[k];
+            if !top.is_finite() {
+                continue;
+            }
+            let [x, y] = hm.cell_center(k % nx, k / nx);
+            let (s, c) = lattice.yaw(o as u8).sin_cos();
+            let body_ok = robot.base_circle_centres_x(0.25).iter().all(|&cx| {
+                hm.cell_of(x + c * cx, y + s * cx)
+                    .and_then(|(a, b)| body.get(a, b))
+                    .is_some_and(|h| h <= top + BODY_RISE_M)
+            });
+            let legs_ok = robot.hips.iter().all(|hp| {
+                HIP_BAND_X.iter().any(|dx| {
+                    HIP_BAND_Y.iter().any(|dy| {
+                        let (bx, by) = (hp[0] - hp[0].signum() * dx, hp[1] + dy);
+                        legs.height_at_cell(x + c * bx - s * by, y + s * bx + c * by)
+                            .is_none_or(|h| h <= top + HIP_RISE_M)
+                    })
+                })
+            });
+            *out = body_ok && legs_ok;
+        }
+        out
+    }
+
+    fn odd_terrain() -> (CostMaps, RobotDescription, Lattice) {
+        // Walls, a tall block and a low platform at odd angles, near the map's edges too.
+        let prims = [
+            Primitive::Box { center: [2.0, 0.3], size: [0.2, 2.5], height: 1.2, yaw_deg: 17.0 },
+            Primitive::Box { center: [3.5, -1.5], size: [1.5, 0.8], height: 0.9, yaw_deg: 40.0 },
+            Primitive::Box { center: [0.5, 1.7], size: [0.6, 0.6], height: 0.3, yaw_deg: -25.0 },
+            Primitive::Box { center: [4.8, 0.0], size: [0.3, 3.0], height: 0.75, yaw_deg: 5.0 },
+            // A closed room of 1.2 m walls.
+            wall([0.2, -0.3], [2.2, 0.2]),
+            wall([0.2, -1.9], [2.2, 0.2]),
+            wall([-0.9, -1.1], [0.2, 1.8]),
+            wall([1.3, -1.1], [0.2, 1.8]),
+        ];
+        let robot = RobotDescription::reference();
+        let hm = rasterise(&prims, [-1.0, -2.0], [6.0, 4.0], 0.025).unwrap();
+        let maps = CostMaps::build(&hm, &robot, &Params::default()).unwrap();
+        let lattice = Lattice::for_map(maps.heights(), 64).unwrap();
+        (maps, robot, lattice)
+    }
+
+    #[test]
+    fn turns_are_cyclic_neighbours_across_words() {
+        let one = |o: usize| {
+            let mut m = [0; MAX_WORDS];
+            m[o / 64] |= 1 << (o % 64);
+            m
+        };
+        let set = |m: Mask, n: usize| {
+            (0..n).filter(|&o| m[o / 64] >> (o % 64) & 1 == 1).collect::<Vec<_>>()
+        };
+        assert_eq!(set(turns(&one(0), 1, 64), 64), vec![1, 63]);
+        assert_eq!(set(turns(&one(63), 1, 64), 64), vec![0, 62]);
+        assert_eq!(set(turns(&one(0), 1, 4), 4), vec![1, 3]);
+        // 100 orientations in two words: 63 and 64 are neighbours, 99 wraps to 0.
+        assert_eq!(set(turns(&one(63), 2, 100), 100), vec![62, 64]);
+        assert_eq!(set(turns(&one(64), 2, 100), 100), vec![63, 65]);
+        assert_eq!(set(turns(&one(99), 2, 100), 100), vec![0, 98]);
+        assert_eq!(set(turns(&one(0), 2, 100), 100), vec![1, 99]);
+        assert_eq!(set(turns(&one(255), 4, 256), 256), vec![0, 254]);
+    }
+
+    #[test]
+    fn the_cell_by_cell_flood_finds_what_a_pair_by_pair_flood_finds() {
+        // Goal beyond the tilted wall; the closed room is cut off.
+        let (maps, robot, lattice) = odd_terrain();
+        let (nx, ny) = maps.heights().dims();
+        let no = usize::from(lattice.orientations);
+        let goal = lattice.state(&crate::geometry::Pose2::new(4.3, 1.0, 0.0)).unwrap();
+        let regions = BaseRegions::build(&maps, &robot, &lattice, 0.25, (goal.i, goal.j));
+        // Reference: breadth-first over (cell, orientation) pairs of the defining test.
+        let ok = admissible_by_definition(&maps, &robot, &lattice);
+        let g = goal.j as usize * nx + goal.i as usize;
+        let mut seen = vec![false; ok.len()];
+        let mut queue: Vec<usize> = (0..no).map(|o| g * no + o).filter(|&n| ok[n]).collect();
+        queue.iter().for_each(|&n| seen[n] = true);
+        while let Some(n) = queue.pop() {
+            let (k, o) = (n / no, n % no);
+            let (i, j) = ((k % nx) as isize, (k / nx) as isize);
+            let mut next = vec![k * no + (o + 1) % no, k * no + (o + no - 1) % no];
+            for b in (j - 2).max(0)..=(j + 2).min(ny as isize - 1) {
+                for a in (i - 2).max(0)..=(i + 2).min(nx as isize - 1) {
+                    next.push((b as usize * nx + a as usize) * no + o);
+                }
+            }
+            for m in next {
+                if ok[m] && !seen[m] {
+                    seen[m] = true;
+                    queue.push(m);
+                }
+            }
+        }
+        let (mut reached, mut cut) = (0, 0);
+        for k in 0..nx * ny {
+            let admitted = (0..no).any(|o| ok[k * no + o]);
+            let reaches = (0..no).any(|o| seen[k * no + o]);
+            let expected = if admitted { u32::from(!reaches) } else { NONE };
+            assert_eq!(regions.region[k], expected, "cell {k}");
+            reached += usize::from(admitted && reaches);
+            cut += usize::from(admitted && !reaches);
+        }
+        assert!(reached > 1000, "{reached} cells reach the goal");
+        assert!(cut > 1000, "{cut} cells in the room cannot");
+    }
+
+    #[test]
+    fn the_cell_shift_scan_matches_the_tests_definition() {
+        let (maps, robot, lattice) = odd_terrain();
+        let scan = admissible(&maps, &robot, &lattice, 0.25).unwrap();
+        let reference = admissible_by_definition(&maps, &robot, &lattice);
+        let no = usize::from(lattice.orientations);
+        let differing =
+            reference.iter().enumerate().filter(|&(n, &r)| scan.get(n / no, n % no) != r).count();
+        let admitted = reference.iter().filter(|&&r| r).count();
+        // Some pairs pass and some fail, so the comparison means something.
+        assert!(admitted > 1000 && admitted < reference.len() - 1000, "{admitted}");
+        assert_eq!(differing, 0, "of {} pairs", reference.len());
     }
 }
