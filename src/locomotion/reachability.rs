@@ -265,6 +265,23 @@ impl BaseRegions {
 
 /// The admissible (cell, orientation) pairs (see the module's doc); `None` if the map
 /// cannot be scanned.
+/// `H_loc` per cell: the highest standable ground near it (a square window holding the
+/// disc of [`FEET_REACH_M`]: a larger window only weakens the test); not standable =
+/// unknown (NaN). `None` if the map cannot be built.
+fn highest_standable_near(maps: &CostMaps) -> Option<HeightMap> {
+    let hm = maps.heights();
+    let (nx, ny) = hm.dims();
+    let res = hm.resolution();
+    let standable: Vec<f64> = (0..nx * ny)
+        .map(|k| match (maps.foot_cost_cell(k % nx, k / nx).finite(), hm.as_slice()[k]) {
+            (Some(_), h) if h.is_finite() => h,
+            _ => f64::NAN,
+        })
+        .collect();
+    let standable = HeightMap::new(hm.origin(), res, nx, ny, standable).ok()?;
+    Some(standable.dilated_max((FEET_REACH_M / res).ceil() as usize))
+}
+
 fn admissible(
     maps: &CostMaps,
     robot: &RobotDescription,
@@ -274,16 +291,7 @@ fn admissible(
     let hm = maps.heights();
     let (nx, ny) = hm.dims();
     let res = hm.resolution();
-    // Highest standable ground near each cell (a square window holding the disc of
-    // FEET_REACH_M: a larger window only weakens the test); not standable = unknown.
-    let standable: Vec<f64> = (0..nx * ny)
-        .map(|k| match (maps.foot_cost_cell(k % nx, k / nx).finite(), hm.as_slice()[k]) {
-            (Some(_), h) if h.is_finite() => h,
-            _ => f64::NAN,
-        })
-        .collect();
-    let standable = HeightMap::new(hm.origin(), res, nx, ny, standable).ok()?;
-    let h_loc = standable.dilated_max((FEET_REACH_M / res).ceil() as usize);
+    let h_loc = highest_standable_near(maps)?;
     let h_loc = h_loc.as_slice();
     let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
     let legs = maps.leg_terrain();
@@ -414,15 +422,7 @@ mod tests {
     ) -> Vec<bool> {
         let hm = maps.heights();
         let (nx, ny) = hm.dims();
-        let res = hm.resolution();
-        let standable: Vec<f64> = (0..nx * ny)
-            .map(|k| match (maps.foot_cost_cell(k % nx, k / nx).finite(), hm.as_slice()[k]) {
-                (Some(_), h) if h.is_finite() => h,
-                _ => f64::NAN,
-            })
-            .collect();
-        let standable = HeightMap::new(hm.origin(), res, nx, ny, standable).unwrap();
-        let h_loc = standable.dilated_max((FEET_REACH_M / res).ceil() as usize);
+        let h_loc = highest_standable_near(maps).unwrap();
         let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
         let legs = maps.leg_terrain();
         let no = usize::from(lattice.orientations);
