@@ -263,8 +263,6 @@ impl BaseRegions {
     }
 }
 
-/// The admissible (cell, orientation) pairs (see the module's doc); `None` if the map
-/// cannot be scanned.
 /// `H_loc` per cell: the highest standable ground near it (a square window holding the
 /// disc of [`FEET_REACH_M`]: a larger window only weakens the test); not standable =
 /// unknown (NaN). `None` if the map cannot be built.
@@ -282,6 +280,8 @@ fn highest_standable_near(maps: &CostMaps) -> Option<HeightMap> {
     Some(standable.dilated_max((FEET_REACH_M / res).ceil() as usize))
 }
 
+/// The admissible (cell, orientation) pairs (see the module's doc); `None` if the map
+/// cannot be scanned.
 fn admissible(
     maps: &CostMaps,
     robot: &RobotDescription,
@@ -345,11 +345,17 @@ mod tests {
     use crate::scenario::Primitive;
     use crate::terrain::rasterise;
 
-    fn regions(prims: &[Primitive], goal: [f64; 2]) -> (BaseRegions, Lattice) {
+    /// The cost maps and lattice of `prims` on a 6 m × 4 m map, with the reference robot.
+    fn world(prims: &[Primitive]) -> (CostMaps, RobotDescription, Lattice) {
         let robot = RobotDescription::reference();
         let hm = rasterise(prims, [-1.0, -2.0], [6.0, 4.0], 0.025).unwrap();
         let maps = CostMaps::build(&hm, &robot, &Params::default()).unwrap();
         let lattice = Lattice::for_map(maps.heights(), 64).unwrap();
+        (maps, robot, lattice)
+    }
+
+    fn regions(prims: &[Primitive], goal: [f64; 2]) -> (BaseRegions, Lattice) {
+        let (maps, robot, lattice) = world(prims);
         let cell = |p: [f64; 2]| {
             let s = lattice.state(&crate::geometry::Pose2::new(p[0], p[1], 0.0)).unwrap();
             (s.i, s.j)
@@ -467,11 +473,7 @@ mod tests {
             wall([-0.9, -1.1], [0.2, 1.8]),
             wall([1.3, -1.1], [0.2, 1.8]),
         ];
-        let robot = RobotDescription::reference();
-        let hm = rasterise(&prims, [-1.0, -2.0], [6.0, 4.0], 0.025).unwrap();
-        let maps = CostMaps::build(&hm, &robot, &Params::default()).unwrap();
-        let lattice = Lattice::for_map(maps.heights(), 64).unwrap();
-        (maps, robot, lattice)
+        world(&prims)
     }
 
     #[test]
@@ -513,8 +515,8 @@ mod tests {
             let (k, o) = (n / no, n % no);
             let (i, j) = ((k % nx) as isize, (k / nx) as isize);
             let mut next = vec![k * no + (o + 1) % no, k * no + (o + no - 1) % no];
-            for b in (j - 2).max(0)..=(j + 2).min(ny as isize - 1) {
-                for a in (i - 2).max(0)..=(i + 2).min(nx as isize - 1) {
+            for b in (j - LINK_CELLS).max(0)..=(j + LINK_CELLS).min(ny as isize - 1) {
+                for a in (i - LINK_CELLS).max(0)..=(i + LINK_CELLS).min(nx as isize - 1) {
                     next.push((b as usize * nx + a as usize) * no + o);
                 }
             }
