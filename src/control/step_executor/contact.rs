@@ -22,7 +22,7 @@ impl StepExecutor {
     /// to lift, is confirming or is putting down is left to the step.
     pub(super) fn comply_stance(&mut self, obs: &Observation, dt: f64) {
         let stepping = match &self.mode {
-            Mode::Segment { .. } => None,
+            Mode::Segment { .. } | Mode::CheckStance { .. } | Mode::Slide { .. } => None,
             Mode::Guard { index, .. } | Mode::Confirm { index, .. } => self.keys[*index].leg,
             Mode::PutDown { leg, .. } => Some(*leg),
             _ => return,

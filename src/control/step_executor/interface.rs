@@ -51,6 +51,17 @@ pub struct ExecutorConfig {
     /// `hold += base_hold_gain · (reference − measured) · heading · dt`, the reference
     /// being the keyframes' base with the stabilising correction, clamped to this length.
     pub max_base_hold_m: f64,
+    /// Stance offset from the plan's footholds beyond which the robot rolls back onto
+    /// them before a step, m (`step_executor::slide`): one cell of the height map
+    /// (`Params::grid_resolution_m`). The plan knows its footholds to a cell; a stance
+    /// within one of them stands where the plan checked it, and every slide moves
+    /// loaded pairs, which on a rolled base changes the wheel a pair rests on.
+    pub slide_threshold_m: f64,
+    /// Fastest stance slide, m/s.
+    pub slide_speed_mps: f64,
+    /// Longest stance slide, s: time to steer the pairs and roll a few centimetres; what
+    /// a slide has not taken back by then is left to the next step's.
+    pub max_slide_s: f64,
     /// Largest stabilising base correction toward the support centroid, m.
     pub max_correction_m: f64,
     /// Time over which a correction increment is applied, s.
@@ -118,6 +129,9 @@ impl ExecutorConfig {
             base_hold_gain: 2.0,
             max_base_lift_m: 0.04,
             max_base_hold_m: 0.04,
+            slide_threshold_m: params.grid_resolution_m,
+            slide_speed_mps: 0.03,
+            max_slide_s: 5.0,
             max_correction_m: 0.06,
             correction_time_s: 0.8,
             max_correction_attempts: 3,
@@ -301,6 +315,18 @@ pub enum ExecEventKind {
         leg: Leg,
         /// Support margin measured before lifting, m.
         margin_m: f64,
+    },
+    /// Before a step the feet stood this far from the plan's footholds, and the robot
+    /// rolled back onto them (`step_executor::slide`).
+    Slide {
+        /// The stance's offset measured from the wheel contacts, m.
+        offset_m: f64,
+        /// How far the slide takes the stance: the whole offset, or its part along the
+        /// heading where no pair steering keeps the ground it stands on, m.
+        slid_m: f64,
+        /// In how many rolls: 2 where the pairs cannot steer straight back but can at
+        /// a smaller angle (forward, then backward, or the other way).
+        rolls: usize,
     },
     /// A stabilising base correction toward the support centroid.
     Correction {

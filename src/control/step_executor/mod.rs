@@ -34,6 +34,13 @@
 //!   roll does that), capped at [`ExecutorConfig::max_base_hold_m`] and scaled back every
 //!   tick to what the legs in contact reach, so it never winds up into a foot pulled off
 //!   the ground.
+//! - **Before a step** (the first keyframe of a path element that lifts a foot) the
+//!   stance is brought back onto the plan's footholds if the wheel contacts MuJoCo
+//!   reports put it more than [`ExecutorConfig::slide_threshold_m`] off them: the pairs
+//!   steer and roll the robot, legs held, where the height map says a steered pair keeps
+//!   its ground (`slide`). The legs cannot move the stance sideways, yet a planned base
+//!   shift ends on a lattice cell up to half a cell to the side of its heading, and
+//!   stance wheels creep.
 //! - **Before a lift** the support margin measured from MuJoCo (CoM over the wheel
 //!   contacts of the three support legs) must reach [`ExecutorConfig::min_lift_margin_m`]
 //!   (2 cm) plus a reserve for the sag of the compliant support legs when the foot unloads
@@ -69,7 +76,8 @@
 //! The executor is cut by job: `interface` (configuration, observation, command, status,
 //! events, failures), `timing` (time laws and segment clock), `actuation` (postures to
 //! joint and wheel targets), `drive` (drive runs handed to the path follower), `segment`
-//! (keyframe tracking, watching the margin of a foot in the air), `guard` (the margin
+//! (keyframe tracking, watching the margin of a foot in the air), `slide` (the stance
+//! rolled back onto its footholds before a step), `guard` (the margin
 //! check and stabilising corrections before a lift, the landing offset), `contact`
 //! (contact confirmation of a placed foot, the emergency put-down) and `recovery` (the
 //! return to the driving posture). This file holds the state machine itself: its modes,
@@ -82,6 +90,7 @@ mod guard;
 mod interface;
 mod recovery;
 mod segment;
+mod slide;
 #[cfg(test)]
 mod test_support;
 mod timing;
@@ -92,6 +101,7 @@ pub use interface::{
     Command, ExecEvent, ExecEventKind, ExecFailure, ExecStatus, ExecutorConfig, Observation,
     Stranding,
 };
+pub use slide::stance_offset;
 pub use timing::{clock_rate, motion_duration, smoothstep, smoothstep_rate};
 
 use super::foot_contact::ContactConfirm;
@@ -118,12 +128,56 @@ enum AfterPutDown {
 
 #[derive(Debug, Clone)]
 enum Mode {
-    Drive { follower: Box<PathFollower>, first: usize, last: usize },
-    Segment { from: Posture, index: usize, elapsed: f64, duration: f64, settle: f64 },
-    Guard { index: usize, wait: f64, attempts: usize, corr_from: [f64; 2] },
-    Confirm { index: usize, confirm: ContactConfirm },
-    PutDown { leg: Leg, lowered: f64, floor: f64, confirm: ContactConfirm, then: AfterPutDown },
-    Recover { from: Posture, to: Posture, elapsed: f64, duration: f64, failure: ExecFailure },
+    Drive {
+        follower: Box<PathFollower>,
+        first: usize,
+        last: usize,
+    },
+    Segment {
+        from: Posture,
+        index: usize,
+        elapsed: f64,
+        duration: f64,
+        settle: f64,
+    },
+    /// The first keyframe of a step is next: the stance is measured on the next tick
+    /// (`slide`).
+    CheckStance {
+        index: usize,
+    },
+    /// Rolling the stance back onto its footholds before keyframe `index` (`slide`).
+    Slide {
+        index: usize,
+        start: [f64; 2],
+        rolls: [[f64; 2]; 2],
+        roll: usize,
+        elapsed: f64,
+        rolling: bool,
+    },
+    Guard {
+        index: usize,
+        wait: f64,
+        attempts: usize,
+        corr_from: [f64; 2],
+    },
+    Confirm {
+        index: usize,
+        confirm: ContactConfirm,
+    },
+    PutDown {
+        leg: Leg,
+        lowered: f64,
+        floor: f64,
+        confirm: ContactConfirm,
+        then: AfterPutDown,
+    },
+    Recover {
+        from: Posture,
+        to: Posture,
+        elapsed: f64,
+        duration: f64,
+        failure: ExecFailure,
+    },
     Finished,
     Stopped(ExecFailure),
     Stranded(ExecFailure, Stranding),
@@ -240,6 +294,8 @@ impl StepExecutor {
         match &self.mode {
             Mode::Drive { first, .. } => *first,
             Mode::Segment { index, .. }
+            | Mode::CheckStance { index }
+            | Mode::Slide { index, .. }
             | Mode::Guard { index, .. }
             | Mode::Confirm { index, .. } => *index,
             _ => self.keys.len(),
@@ -310,6 +366,10 @@ impl StepExecutor {
                     Err(e) => self.fail(ExecFailure::Follower { message: e.to_string() }, time),
                 }
             }
+            _ if self.starts_a_step(i) => {
+                self.retries = 0;
+                self.mode = Mode::CheckStance { index: i };
+            }
             Phase::Lift => {
                 self.retries = 0;
                 self.mode =
@@ -336,12 +396,23 @@ impl StepExecutor {
     /// The base height and position holds (`ExecutorConfig::base_hold_gain`,
     /// `ExecutorConfig::max_base_hold_m`): in the standing modes that command postures
     /// through [`Self::with_offsets`], integrate how far the measured base stands below
-    /// the commanded one, and how far it stands from it in the plane; elsewhere (driving,
-    /// the return to the driving posture, finished) both are dropped.
+    /// the commanded one, and how far it stands from it in the plane; during a stance
+    /// slide both are kept as they are; elsewhere (driving, the return to the driving
+    /// posture, finished) both are dropped.
     fn hold_base(&mut self, obs: &Observation, dt: f64) {
+        // A stance slide moves base and feet together on the wheels: the holds keep their
+        // values, or the position hold would move the base over the feet while the wheels
+        // carry it, and the feet would end off by what it moved.
+        if matches!(self.mode, Mode::Slide { .. }) {
+            return;
+        }
         let standing = matches!(
             self.mode,
-            Mode::Segment { .. } | Mode::Guard { .. } | Mode::Confirm { .. } | Mode::PutDown { .. }
+            Mode::Segment { .. }
+                | Mode::CheckStance { .. }
+                | Mode::Guard { .. }
+                | Mode::Confirm { .. }
+                | Mode::PutDown { .. }
         );
         if !standing {
             self.base_lift = 0.0;
@@ -399,6 +470,13 @@ impl StepExecutor {
             }
             Mode::Segment { from, index, elapsed, duration, settle } => {
                 self.segment_tick(obs, dt, from, index, elapsed, duration, settle)
+            }
+            Mode::CheckStance { index } => {
+                self.check_stance(index, obs);
+                self.step_mode(obs, dt)
+            }
+            Mode::Slide { index, start, rolls, roll, elapsed, rolling } => {
+                self.slide_tick(obs, dt, index, start, rolls, roll, elapsed, rolling)
             }
             Mode::Guard { index, wait, attempts, corr_from } => {
                 self.guard_tick(obs, dt, index, wait, attempts, corr_from)
