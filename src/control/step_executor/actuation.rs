@@ -16,6 +16,13 @@ pub fn rolling_wheel_speed(robot: &RobotDescription, v: [f64; 2], yaw: f64) -> f
     (c * v[0] + s * v[1]) / robot.wheel_radius
 }
 
+/// Where each wheel pair stands in the base's plane (x', y', m) for posture `p`: its
+/// contact under the base plus the hip's offset, what the wheel kinematics take.
+pub(super) fn pairs_in_base(robot: &RobotDescription, p: &Posture) -> [[f64; 2]; 4] {
+    let local = contacts_in_base(robot, p);
+    std::array::from_fn(|i| [local[i][0] + robot.hips[i][0], local[i][1] + robot.hips[i][1]])
+}
+
 /// Spare reach the executor keeps when it has to pull a foot in, m.
 pub(super) const REACH_SPARE_M: f64 = 0.001;
 

@@ -144,14 +144,7 @@ impl StepExecutor {
                 self.cmd = p;
                 self.cmd.contact[i] = true;
                 match then {
-                    AfterPutDown::Retry(lift) => {
-                        self.mode = Mode::Guard {
-                            index: lift,
-                            wait: 0.0,
-                            attempts: 0,
-                            corr_from: self.correction,
-                        };
-                    }
+                    AfterPutDown::Retry(lift) => self.start_guard(lift),
                     AfterPutDown::Recover(f) => self.start_recover(f),
                 }
             }

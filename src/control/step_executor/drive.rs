@@ -16,10 +16,11 @@
 //! `base_rise_speed_mps`: a base thrown up faster leaves the ground with all its wheels
 //! when the rise stops.
 
+use super::actuation::pairs_in_base;
 use super::{Command, ExecFailure, Mode, Observation, StepExecutor, planar};
 use crate::control::path_follower::{FollowerStatus, PathFollower};
 use crate::geometry::wrap_angle;
-use crate::motion::kinematics::{Posture, contacts_in_base, interpolate};
+use crate::motion::kinematics::{Posture, interpolate};
 use crate::robot::Leg;
 
 /// How far a drive run moves a foot from its keyframe height to where its wheels rest,
@@ -161,10 +162,7 @@ impl StepExecutor {
         self.cmd = p;
         self.mode = Mode::Drive { follower, first, last };
         let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
-        let local = contacts_in_base(&self.robot, &p);
-        let feet: [[f64; 2]; 4] = std::array::from_fn(|i| {
-            [local[i][0] + self.robot.hips[i][0], local[i][1] + self.robot.hips[i][1]]
-        });
+        let feet = pairs_in_base(&self.robot, &p);
         let wheels = self.config.wheels.commands(&self.robot, out.twist, &feet, &obs.steering);
         Command { legs, wheels: self.with_steer_rate(wheels, obs) }
     }

@@ -54,6 +54,12 @@ const CORRECTION_COM_FRACTION: f64 = 0.8;
 const MIN_CORRECTION_M: f64 = 0.002;
 
 impl StepExecutor {
+    /// Starts the lift guard of keyframe `index` from its beginning: no wait yet, no
+    /// correction attempted, the correction faded from where it stands.
+    pub(super) fn start_guard(&mut self, index: usize) {
+        self.mode = Mode::Guard { index, wait: 0.0, attempts: 0, corr_from: self.correction };
+    }
+
     /// The correction on the way from `from` to `to` that goes furthest while no support
     /// leg in contact (all but `lifting`, whose foot leaves the ground anyway) asks more
     /// reach than it does at `from` (or than it has): a base moved over planted feet

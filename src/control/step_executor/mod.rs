@@ -372,8 +372,7 @@ impl StepExecutor {
             }
             Phase::Lift => {
                 self.retries = 0;
-                self.mode =
-                    Mode::Guard { index: i, wait: 0.0, attempts: 0, corr_from: self.correction };
+                self.start_guard(i);
             }
             _ => self.start_segment(i),
         }

@@ -32,10 +32,11 @@
 //! heading cancelling), and where those fail too, only the part along the heading is
 //! rolled, straight, over footholds the plan checked.
 
+use super::actuation::pairs_in_base;
 use super::{Command, ExecEventKind, ExecutorConfig, Mode, Observation, StepExecutor};
 use crate::control::wheels::Twist;
 use crate::motion::Phase;
-use crate::motion::kinematics::{Posture, contacts_in_base};
+use crate::motion::kinematics::Posture;
 use crate::robot::{Leg, RobotDescription};
 
 /// Slide speed per metre of remaining offset, 1/s: the speed falls off over the last
@@ -94,6 +95,16 @@ pub fn stance_offset(
         n += 1;
     }
     (n >= 2).then(|| sum.map(|s| s / n as f64))
+}
+
+/// `p` with every foot moved by `by` (world x, y, m).
+fn feet_moved(p: &Posture, by: [f64; 2]) -> Posture {
+    let mut q = *p;
+    for f in q.feet.iter_mut() {
+        f[0] += by[0];
+        f[1] += by[1];
+    }
+    q
 }
 
 /// The twist (robot frame) that moves a robot at heading `yaw` toward a remaining world
@@ -157,19 +168,12 @@ impl StepExecutor {
         }
         let p = self.with_offsets(&self.cmd);
         // The feet stand at the planned footholds plus the offset now.
-        let mut now = p;
-        for f in now.feet.iter_mut() {
-            f[0] += offset[0];
-            f[1] += offset[1];
-        }
+        let now = feet_moved(&p, offset);
         let safe = |rolls: &[[f64; 2]]| {
             let mut at = now;
             rolls.iter().all(|r| {
                 let ok = self.steering_keeps_the_ground(&at, *r, r[1].atan2(r[0]));
-                for f in at.feet.iter_mut() {
-                    f[0] += r[0];
-                    f[1] += r[1];
-                }
+                at = feet_moved(&at, *r);
                 ok
             })
         };
@@ -249,7 +253,7 @@ impl StepExecutor {
     /// lift guard for a lift, else the segment.
     fn proceed(&mut self, index: usize) {
         if self.keys[index].phase == Phase::Lift {
-            self.mode = Mode::Guard { index, wait: 0.0, attempts: 0, corr_from: self.correction };
+            self.start_guard(index);
         } else {
             self.start_segment(index);
         }
@@ -302,10 +306,7 @@ impl StepExecutor {
             return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
         }
         let twist = slide_twist(remaining(roll), obs.base.theta, c.slide_speed_mps);
-        let local = contacts_in_base(&self.robot, &p);
-        let feet: [[f64; 2]; 4] = std::array::from_fn(|i| {
-            [local[i][0] + self.robot.hips[i][0], local[i][1] + self.robot.hips[i][1]]
-        });
+        let feet = pairs_in_base(&self.robot, &p);
         let wheels = c.wheels.commands(&self.robot, twist, &feet, &obs.steering);
         self.mode = next(elapsed + dt);
         Command { legs, wheels: self.with_steer_rate(wheels, obs) }
