@@ -11,6 +11,7 @@
 mod common;
 
 use momaro::control::step_executor::{ExecEventKind, ExecFailure};
+use momaro::jobs::envelope::{self, Direction};
 use momaro::jobs::plan::{self, PathKind, PlanOptions, PlanSummary};
 use momaro::jobs::run::{self, Mission, Push, PushWhen, RunOptions, RunSummary};
 use momaro::motion::{DetailedPath, Phase};
@@ -159,8 +160,8 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
     // executor must see it, put the foot down at once, and retry the step once the margin
     // is back.
     let sc = common::scenario("platform");
-    // 300 N: 150 N leaves the 20 cm margin at 19 cm; 400 N keeps wheels off for 1.9 s
-    // and the step is aborted.
+    // 300 N: 150 N left a 20 cm margin at 19 cm; 400 N kept wheels off for 1.9 s and the
+    // step was aborted (measured with an earlier plan).
     let robot = Simulation::robot_only(&common::model()).expect("model").robot().clone();
     let step =
         first_step_up(&plan::run(&sc, &robot, &plan_options()).expect("plan"), Leg::FrontLeft);
@@ -190,13 +191,17 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
         .expect("the foot was put down");
     assert_eq!(put_down.1, Leg::FrontLeft);
     assert!(put_down.0 >= r.start_s && put_down.0 <= r.start_s + 0.2, "{put_down:?} {r:?}");
-    // … the support wheels came back within 1 s (measured 0.55 s) and the robot stayed
-    // upright …
-    assert!(r.negative_margin_s <= 1.0, "{r:?}");
+    // … the support wheels came back within 1.5 s and the robot stayed upright. (With
+    // legs planned at full reach the swing stance had 15 cm of margin: wheels back after
+    // 0.55 s, tilt 8.9°. With 2 cm of reach to spare it has 9 cm: 1.14 s and 18.4°, the
+    // same with the foot put down at the first low sample, 1.15 s and 17.0°; with 180 N
+    // instead, 1.13 s and 7.0°: the time is the put-down's and the retry's, not the
+    // push's.)
+    assert!(r.negative_margin_s <= 1.5, "{r:?}");
     // (Tilt includes the commanded roll and the retry's larger stabilising roll; the
     // monitor counts a tilt of 35° as tipping.)
-    assert!(r.max_tilt_deg < 15.0, "{r:?}");
-    assert!(s.max_tilt_deg < 15.0, "{}", s.max_tilt_deg);
+    assert!(r.max_tilt_deg < 20.0, "{r:?}");
+    assert!(s.max_tilt_deg < 20.0, "{}", s.max_tilt_deg);
     assert!(s.body_collisions.is_empty(), "{:?}", s.body_collisions);
     // (The monitor's TipOver events mark the moments the margin was negative, which the
     // push causes by design; tilt and recovery time above are what "not tipping over"
@@ -476,18 +481,7 @@ fn a_flight_approached_off_the_grid_axes_is_descended_with_the_feet_on_their_foo
     // stood 5 cm from their footholds after 12 steps and the run was stranded by a
     // 0.150 m drift after 24 of 27. The executor now rolls the stance back onto the
     // footholds before a lift (`step_executor::slide`).
-    let sc = common::generated(momaro::scenario::generate::Class::Stairs, 27);
-    let s = run::run(&sc, &RunOptions::new(plan_options(), common::model())).expect("run");
-    println!(
-        "stairs 27: goal {:.3} m, {} of {} steps, min margin {:.3} m, wall {:.1} s",
-        s.goal_position_error_m,
-        s.steps_executed,
-        s.steps_planned,
-        s.min_stability_margin_m,
-        s.wall_time_s
-    );
-    assert_clean(&s);
-    assert!(s.passed, "{s:#?}");
+    let s = run_clean(&common::generated(momaro::scenario::generate::Class::Stairs, 27));
     let slides: Vec<f64> = s
         .executor_events
         .iter()
@@ -499,4 +493,37 @@ fn a_flight_approached_off_the_grid_axes_is_descended_with_the_feet_on_their_foo
     assert!(!slides.is_empty(), "{:?}", s.executor_events);
     // Taken out before each lift, the offset never grows past a few centimetres.
     assert!(slides.iter().all(|&o| o < 0.05), "{slides:?}");
+}
+
+#[test]
+fn a_descent_planned_with_a_leg_at_full_reach_is_now_planned_with_reach_to_spare() {
+    // The stairs envelope's 0.14 m × 0.35 m flight, down. With 2 mm of reach to spare,
+    // the front-right pair was driven toward the centre for the last rear step until its
+    // leg stood at full length: the servos' give (which the executor's holds make up by
+    // lengthening the legs) left the wheel 2.3 cm short and the base 2 cm behind its
+    // keyframe, the lift measured 4.8 cm where the plan had 6.2 cm, and the step was
+    // aborted (the run stranded mid-flight). Legs now keep 2 cm
+    // (`StandingRule::reach_margin_m`).
+    let dir = common::temp_dir("envelope_down_r140_t350");
+    let path = dir.join("stairs_down_r140_t350_n3.toml");
+    std::fs::write(&path, envelope::cell_toml(Direction::Down, 0.14, 0.35, 3)).expect("write");
+    run_clean(&Scenario::load(&path).expect("the cell loads"));
+}
+
+/// Runs `sc` as `momaro run` does with the tests' planner options, prints its outcome, and
+/// asserts that it passed cleanly ([`assert_clean`]).
+fn run_clean(sc: &Scenario) -> RunSummary {
+    let s = run::run(sc, &RunOptions::new(plan_options(), common::model())).expect("run");
+    println!(
+        "{}: goal {:.3} m, {} of {} steps, min margin {:.3} m, wall {:.1} s",
+        sc.name,
+        s.goal_position_error_m,
+        s.steps_executed,
+        s.steps_planned,
+        s.min_stability_margin_m,
+        s.wall_time_s
+    );
+    assert_clean(&s);
+    assert!(s.passed, "{s:#?}");
+    s
 }

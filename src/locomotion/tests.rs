@@ -325,9 +325,9 @@ mod hybrid {
     fn front_steps_onto_a_platform_cost_eq_5() {
         let maps = platform_maps(0.2);
         let mut g = graph(&maps, LatticeState::new(0, 0, 0));
-        // Front feet at x = 0.4875 + 0.35 = 0.8375, 0.1625 m before the edge: within
+        // Front feet at x = 0.5125 + 0.35 = 0.8625, 0.1375 m before the edge: within
         // 0.1 m of the infinite band (0.12 m around the edge cells at 0.9875 / 1.0125).
-        let s = state_at(&g, 0.48, 0.0);
+        let s = state_at(&g, 0.505, 0.0);
         let steps: Vec<_> = g
             .labelled_successors(s)
             .into_iter()
@@ -337,18 +337,18 @@ mod hybrid {
         assert_eq!(legs, vec![Some(Leg::FrontLeft), Some(Leg::FrontRight)]);
         for (t, c, m) in &steps {
             let st = m.step.expect("step details");
-            // The cheapest foothold: flat (C_F = 1) platform, 0.475 m ahead (19 cells,
-            // the reach of a leg 0.2 m shorter), ΔH = 0.2.
-            assert!((st.length_m - 0.475).abs() < 1e-9, "{st:?}");
+            // The cheapest foothold: flat (C_F = 1) platform, 0.45 m ahead (18 cells,
+            // the reach of a leg 0.2 m shorter with 2 cm to spare), ΔH = 0.2.
+            assert!((st.length_m - 0.45).abs() < 1e-9, "{st:?}");
             assert_eq!(st.foothold_cost, 1.0);
             assert!((st.height_m - 0.2).abs() < 1e-12);
-            let c_s = 0.5 * 0.475 + 2.3 * 0.2;
+            let c_s = 0.5 * 0.45 + 2.3 * 0.2;
             assert!((st.c_s - c_s).abs() < 1e-12);
             let f = Params::default().step_cost_factor;
             assert_eq!(*c, Cost::from_f64_ceil(f * c_s * (1.0 - 1e-12)));
             assert_eq!((t.i, t.j, t.theta), (s.i, s.j, s.theta), "the base stays");
             let o = g.offsets(*t).expect("interned");
-            assert_eq!(o.iter().filter(|&&v| v == 19).count(), 1);
+            assert_eq!(o.iter().filter(|&&v| v == 18).count(), 1);
         }
     }
 
@@ -389,7 +389,7 @@ mod hybrid {
     fn base_shift_after_both_front_steps_costs_c_bs() {
         let maps = platform_maps(0.2);
         let mut g = graph(&maps, LatticeState::new(0, 0, 0));
-        let s = state_at(&g, 0.48, 0.0);
+        let s = state_at(&g, 0.505, 0.0);
         let fl = g
             .labelled_successors(s)
             .into_iter()
@@ -402,7 +402,7 @@ mod hybrid {
             .find(|(_, _, m)| m.kind == ManoeuvreKind::Step)
             .expect("front right step")
             .0;
-        assert_eq!(g.offsets(both), Some([19, 19, 0, 0]));
+        assert_eq!(g.offsets(both), Some([18, 18, 0, 0]));
         let (t, c, m) = g
             .labelled_successors(both)
             .into_iter()
@@ -413,18 +413,18 @@ mod hybrid {
         // by the front feet on the platform): the robot can stand at the shift's end and
         // not one cell further.
         let o = g.offsets(t).expect("interned");
-        let l = i32::from(o[0]) - 19;
+        let l = i32::from(o[0]) - 18;
         assert!(l < 0 && o == [o[0], o[0], l as i8, l as i8], "{o:?}");
         assert_eq!(i32::from(t.i - s.i), -l);
         assert!((m.length_m - f64::from(-l) * 0.025).abs() < 1e-9);
         let robot = RobotDescription::reference();
         let rule = crate::motion::StandingRule::from_params(&Params::default());
         let stands = |cells: i32| {
-            let base = 0.48 + f64::from(s.i - state_at(&g, 0.48, 0.0).i) * 0.025;
+            let base = 0.505 + f64::from(s.i - state_at(&g, 0.505, 0.0).i) * 0.025;
             let x = base + f64::from(cells) * 0.025;
             let feet = [
-                [base + 0.35 + 0.475, 0.32, 0.2],
-                [base + 0.35 + 0.475, -0.32, 0.2],
+                [base + 0.35 + 0.45, 0.32, 0.2],
+                [base + 0.35 + 0.45, -0.32, 0.2],
                 [base - 0.35, 0.32, 0.0],
                 [base - 0.35, -0.32, 0.0],
             ];
@@ -791,7 +791,7 @@ mod hybrid {
         assert_eq!(a.heuristic_parts(s).steps, b.heuristic_parts(s).steps);
         let mut steps = 0;
         for k in 0..40 {
-            for o in [0, 4, 8, 12] {
+            for o in [0, 2, 4, 6, 8, 10, 12, 14, 16] {
                 let base = state_at(&a, 0.025 * f64::from(k), 0.0);
                 let of = |g: &mut HybridGraph<'_>| -> Vec<_> {
                     let s = g.with_offsets(base, [o, o, 0, 0]).expect("interned");

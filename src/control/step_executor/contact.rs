@@ -227,6 +227,51 @@ mod tests {
     }
 
     #[test]
+    fn a_dip_shorter_than_the_monitors_hold_does_not_put_the_foot_down() {
+        // 0.03 s of support memory + 0.05 s of margin hold.
+        assert!((config().emergency_hold_s - 0.08).abs() < 1e-12);
+        let keys = step_path();
+        let feet = keys[0].feet;
+        let without_fl: Vec<_> =
+            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        // The CoM 0.14 m inside the FR–RL diagonal; a dip is the rear-left pair off the
+        // ground (FR and RR left: the CoM is 0.22 m outside their line).
+        let com = [-0.1, -0.1, 0.4];
+        let dip: Vec<_> = without_fl.iter().copied().filter(|(l, _)| *l != Leg::RearLeft).collect();
+        // Ticks of 10 ms: a dip of `n` ticks, starting 0.2 s after the lift.
+        let put_down_after = |n: usize| {
+            let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+            let (mut t, mut lifted) = (0.0, None);
+            for _ in 0..150 {
+                t += 0.01;
+                let k = lifted.map_or(0, |l: f64| ((t - l) / 0.01).round() as usize);
+                let c = if (20..20 + n).contains(&k) { &dip } else { &without_fl };
+                let o = obs(t, &ex, c, com);
+                if (20..20 + n).contains(&k) {
+                    assert!(o.support_margin(Leg::FrontLeft) < 0.0);
+                }
+                ex.tick(&o, 0.01);
+                if lifted.is_none() && ex.active_step().is_some() {
+                    lifted = Some(t);
+                }
+            }
+            let lifted = lifted.expect("lifted");
+            ex.events.iter().find_map(|e| match e.event {
+                ExecEventKind::FootPutDown { .. } => Some(e.time_s - (lifted + 0.2)),
+                _ => None,
+            })
+        };
+        // 70 ms below the emergency margin: the monitor does not count it, nor does the
+        // executor.
+        assert_eq!(put_down_after(7), None);
+        // 80 ms and longer: put down on the dip's eighth sample, 70 ms after its first.
+        for n in [8, 30] {
+            let at = put_down_after(n).expect("put down");
+            assert!((at - 0.07).abs() < 1e-6, "{n}: {at}");
+        }
+    }
+
+    #[test]
     fn the_base_height_hold_raises_a_sunken_base_up_to_its_cap() {
         // The keyframes stand the base 0.5 m up; MuJoCo measures it 2 cm lower. With the
         // gain 2/s the raise after 0.1 s of 10 ms ticks is 2 · 0.02 · 0.1 = 4 mm; 10 cm
@@ -295,6 +340,37 @@ mod tests {
         ex.mode = Mode::Finished;
         ex.tick(&obs(0.2, &ex, &contacts, com), 0.01);
         assert_eq!(ex.base_hold, [0.0, 0.0]);
+    }
+
+    #[test]
+    fn before_a_lift_the_foot_about_to_leave_the_ground_does_not_bound_the_hold() {
+        // FL stands 0.40 m behind its hip (0.27 m below it): a base moved ahead by h
+        // stretches it to √((0.40 + h)² + 0.27²), its 0.499 m reach at h = 0.0196 m; the
+        // other feet under their hips allow 0.42 m. Waiting to lift FL (the guard, its
+        // settle made long), the base measured 10 cm behind for 0.3 s asks 6 cm of hold:
+        // the 4 cm cap, not FL's 1.96 cm, which would cancel the guard's corrections
+        // (measured on a stair: the hold at its cap shrank by what each correction added,
+        // the base did not move, the step was aborted at 4.92 of 5 cm).
+        let r = robot();
+        let mut keys = step_path();
+        for k in &mut keys {
+            k.feet[0][0] = r.hips[0][0] - 0.40;
+            k.joints = crate::motion::kinematics::leg_joint_targets(&r, &k.posture()).unwrap();
+        }
+        let cfg = ExecutorConfig { lift_settle_s: 10.0, ..config() };
+        let mut ex = StepExecutor::new(&r, cfg, keys.clone(), ground());
+        let contacts = all_contacts(&keys[0].feet);
+        for k in 0..30 {
+            let mut o = obs(0.01 * (k + 1) as f64, &ex, &contacts, [-0.1, -0.1, 0.4]);
+            o.base = Pose2::new(-0.1, 0.0, 0.0);
+            ex.tick(&o, 0.01);
+        }
+        assert!(matches!(ex.mode, Mode::Guard { .. }), "{:?}", ex.mode);
+        assert!((ex.base_hold[0] - config().max_base_hold_m).abs() < 1e-12, "{:?}", ex.base_hold);
+        // FL would be pulled in (it is lifted next); the feet that stay are within reach.
+        let solved = ex.held(&ex.cmd);
+        assert!(reach_excess(&r, &solved, REACH_SPARE_M, None) > 0.0);
+        assert!(reach_excess(&r, &solved, REACH_SPARE_M, Some(Leg::FrontLeft)) <= 0.0);
     }
 
     #[test]

@@ -3,8 +3,11 @@
 //! base is moved toward the support centroid in bounded increments (a base shift
 //! longitudinally, a roll about the ground laterally: [`correction_roll`]) as far as the
 //! planted legs reach (`StepExecutor::within_reach`), without the roll where the wheels
-//! it tilts the pairs onto are predicted to lose margin (`StepExecutor::predicted_margin`),
-//! else the step is aborted. At the lift the landing offset ([`landing_offset`]) of the
+//! it tilts the pairs onto are predicted to lose margin (`StepExecutor::predicted_margin`).
+//! Increments go on while they pay: the step is aborted after
+//! `ExecutorConfig::max_correction_attempts` increments that each raised the measured
+//! margin by less than [`MIN_CORRECTION_GAIN_M`] ([`Corrections`]), or when the legs'
+//! reach or `ExecutorConfig::max_correction_m` leaves no increment. At the lift the landing offset ([`landing_offset`]) of the
 //! swing foot is frozen.
 
 use super::actuation::{REACH_SPARE_M, reach_excess, reachable_fraction};
@@ -53,11 +56,50 @@ const CORRECTION_COM_FRACTION: f64 = 0.8;
 /// stopped the base.
 const MIN_CORRECTION_M: f64 = 0.002;
 
+/// The smallest rise of the measured margin for which an increment counts as paying, m:
+/// half of what the smallest increment moves the CoM ([`MIN_CORRECTION_M`] ·
+/// [`CORRECTION_COM_FRACTION`]).
+pub(super) const MIN_CORRECTION_GAIN_M: f64 = 0.5 * MIN_CORRECTION_M * CORRECTION_COM_FRACTION;
+
+/// The increments the guard has made before a lift.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Corrections {
+    /// Increments made.
+    pub made: usize,
+    /// Increments after which the measured margin rose by less than
+    /// [`MIN_CORRECTION_GAIN_M`]: a count that stops the guard where the CoM no longer
+    /// follows the base, while a margin that rises slowly (measured on a rear step: 3.95,
+    /// 4.65, 4.92 cm after three increments, 5 cm asked) is followed up.
+    pub fruitless: usize,
+    /// The margin measured at the last check, m (−∞ before the first).
+    pub measured_m: f64,
+}
+
+impl Corrections {
+    /// No increment yet.
+    pub const NONE: Self = Self { made: 0, fruitless: 0, measured_m: f64::NEG_INFINITY };
+
+    /// After a check that measured `margin_m`: whether the increment before it paid.
+    fn checked(self, margin_m: f64) -> Self {
+        let paid = self.made == 0 || margin_m - self.measured_m >= MIN_CORRECTION_GAIN_M;
+        Self {
+            made: self.made,
+            fruitless: self.fruitless + usize::from(!paid),
+            measured_m: margin_m,
+        }
+    }
+}
+
 impl StepExecutor {
     /// Starts the lift guard of keyframe `index` from its beginning: no wait yet, no
     /// correction attempted, the correction faded from where it stands.
     pub(super) fn start_guard(&mut self, index: usize) {
-        self.mode = Mode::Guard { index, wait: 0.0, attempts: 0, corr_from: self.correction };
+        self.mode = Mode::Guard {
+            index,
+            wait: 0.0,
+            corrections: Corrections::NONE,
+            corr_from: self.correction,
+        };
     }
 
     /// The correction on the way from `from` to `to` that goes furthest while no support
@@ -102,14 +144,14 @@ impl StepExecutor {
         dt: f64,
         index: usize,
         mut wait: f64,
-        mut attempts: usize,
+        corrections: Corrections,
         corr_from: [f64; 2],
     ) -> Command {
         let time = obs.time;
         let leg = self.keys[index].leg.unwrap_or(Leg::FrontLeft);
         let c = self.config.clone();
         wait += dt;
-        let ramp = if attempts == 0 { 1.0 } else { smoothstep(wait / c.correction_time_s) };
+        let ramp = if corrections.made == 0 { 1.0 } else { smoothstep(wait / c.correction_time_s) };
         let target = self.correction;
         let applied = [
             corr_from[0] + (target[0] - corr_from[0]) * ramp,
@@ -117,17 +159,19 @@ impl StepExecutor {
         ];
         let p = self.with_correction(&self.cmd, applied);
         let Some(legs) = self.legs_for(&p, time) else { return self.hold() };
-        let ready = wait >= c.lift_settle_s + if attempts == 0 { 0.0 } else { c.correction_time_s };
+        let ready =
+            wait >= c.lift_settle_s + if corrections.made == 0 { 0.0 } else { c.correction_time_s };
         if !ready {
-            self.mode = Mode::Guard { index, wait, attempts, corr_from };
+            self.mode = Mode::Guard { index, wait, corrections, corr_from };
             return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
         }
         let m = obs.support_margin(leg);
+        let planned_m = self.keys[index].margin_m;
         let required = c.min_lift_margin_m
             + c.lift_margin_reserve_m
             + self.retries as f64 * c.retry_margin_increment_m;
         if m >= required {
-            self.event(time, ExecEventKind::Lift { leg, margin_m: m });
+            self.event(time, ExecEventKind::Lift { leg, margin_m: m, planned_m });
             if self.retries == 0 {
                 self.steps_started += 1;
             }
@@ -145,9 +189,10 @@ impl StepExecutor {
             self.start_segment(index);
             return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
         }
+        let corrections = corrections.checked(m);
         let centroid = obs.support_centroid(leg);
         let total = self.correction[0].hypot(self.correction[1]);
-        if attempts < c.max_correction_attempts
+        if corrections.fruitless < c.max_correction_attempts
             && total < c.max_correction_m - 1e-6
             && let Some(cen) = centroid
         {
@@ -190,13 +235,16 @@ impl StepExecutor {
                         correction_m: next[0].hypot(next[1]),
                     },
                 );
-                attempts += 1;
-                self.mode = Mode::Guard { index, wait: 0.0, attempts, corr_from: from };
+                let corrections = Corrections { made: corrections.made + 1, ..corrections };
+                self.mode = Mode::Guard { index, wait: 0.0, corrections, corr_from: from };
                 return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
             }
         }
         self.steps_aborted += 1;
-        self.fail(ExecFailure::StepAborted { leg, margin_m: m, required_m: required }, time);
+        self.fail(
+            ExecFailure::StepAborted { leg, margin_m: m, required_m: required, planned_m },
+            time,
+        );
         Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) }
     }
 }
@@ -291,21 +339,90 @@ mod tests {
         assert!(ex.landing[1].abs() < 1e-12);
     }
 
-    #[test]
-    fn a_low_margin_is_corrected_toward_the_centroid_then_the_step_is_aborted() {
+    /// An executor at the front-left step of [`step_path`] (corrections up to 0.2 m), and
+    /// the wheel contacts of the other three feet.
+    fn waiting_to_lift_front_left() -> (StepExecutor, Vec<(Leg, [f64; 2])>) {
         let keys = step_path();
         let cfg = ExecutorConfig { max_correction_m: 0.2, ..config() };
-        let mut ex = StepExecutor::new(&robot(), cfg, keys.clone(), ground());
-        let feet = keys[0].feet;
-        let without_fl: Vec<_> =
-            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
-        // The CoM 1 cm inside the FR–RL diagonal (x = −y·0.35/0.32 through the origin):
-        // a measured margin of 1 cm, below the 2 cm (plus reserve) to lift. It does not
-        // move (the corrections have no effect here), so after three corrections the step
-        // is aborted with the foot never lifted.
+        let ex = StepExecutor::new(&robot(), cfg, keys.clone(), ground());
+        let without_fl =
+            all_contacts(&keys[0].feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        (ex, without_fl)
+    }
+
+    /// The point `d` inside the FR–RL diagonal of [`step_path`]'s stance (the line
+    /// x = −y · 0.35 / 0.32 through the origin), on its normal through the origin.
+    fn inside_fr_rl(d: f64) -> [f64; 2] {
         let n = [0.32f64, 0.35];
         let len = n[0].hypot(n[1]);
-        let com = [-0.01 * n[0] / len, -0.01 * n[1] / len, 0.4];
+        [-d * n[0] / len, -d * n[1] / len]
+    }
+
+    #[test]
+    fn an_increment_pays_when_the_margin_rises_by_the_smallest_gain() {
+        // 0.5 · 2 mm · 0.8 = 0.8 mm.
+        assert!((MIN_CORRECTION_GAIN_M - 0.0008).abs() < 1e-15);
+        // The first check has nothing to compare with.
+        let c = Corrections::NONE.checked(0.03);
+        assert_eq!((c.fruitless, c.measured_m), (0, 0.03));
+        let c = Corrections { made: 1, ..c };
+        // 3.95 → 4.65 cm pays, 4.65 → 4.70 does not.
+        let c = Corrections { measured_m: 0.0395, ..c }.checked(0.0465);
+        assert_eq!(c.fruitless, 0);
+        let c = c.checked(0.0470);
+        assert_eq!((c.fruitless, c.measured_m), (1, 0.0470));
+        // A margin that falls is fruitless too.
+        assert_eq!(c.checked(0.0460).fruitless, 2);
+    }
+
+    #[test]
+    fn increments_go_on_while_the_measured_margin_rises() {
+        // The CoM starts 3 cm inside the FR–RL diagonal (3 cm measured, 5 cm asked) and
+        // follows 30 % of the base's correction: each increment gains a few millimetres,
+        // and three increments are not enough (the guard used to abort after three).
+        let (mut ex, without_fl) = waiting_to_lift_front_left();
+        let com0 = inside_fr_rl(0.03);
+        let com = |ex: &StepExecutor| {
+            [com0[0] + 0.3 * ex.correction[0], com0[1] + 0.3 * ex.correction[1], 0.4]
+        };
+        let mut t = 0.0;
+        let mut margins = Vec::new();
+        while ex.active_step().is_none() && ex.steps_aborted == 0 && t < 60.0 {
+            t += 0.01;
+            let o = obs(t, &ex, &without_fl, com(&ex));
+            margins.push(o.support_margin(Leg::FrontLeft));
+            ex.tick(&o, 0.01);
+        }
+        let corrections: Vec<f64> = ex
+            .events
+            .iter()
+            .filter_map(|e| match e.event {
+                ExecEventKind::Correction { margin_m, .. } => Some(margin_m),
+                _ => None,
+            })
+            .collect();
+        assert!(ex.active_step().is_some(), "aborted after {corrections:?}");
+        assert!(corrections.len() > 3, "{corrections:?}");
+        // Each increment paid: the margin measured at the next check rose by at least
+        // the smallest gain.
+        for w in corrections.windows(2) {
+            assert!(w[1] - w[0] >= MIN_CORRECTION_GAIN_M, "{corrections:?}");
+        }
+        let lift = ex.events.iter().find_map(|e| match e.event {
+            ExecEventKind::Lift { margin_m, .. } => Some(margin_m),
+            _ => None,
+        });
+        assert!(lift.is_some_and(|m| m >= 0.05), "{lift:?}");
+    }
+
+    #[test]
+    fn a_low_margin_is_corrected_toward_the_centroid_then_the_step_is_aborted() {
+        let (mut ex, without_fl) = waiting_to_lift_front_left();
+        // The CoM 1 cm inside the FR–RL diagonal: a measured margin of 1 cm, below the
+        // 2 cm (plus reserve) to lift. It does not move (the corrections have no effect
+        // here), so after three corrections the step is aborted with the foot never lifted.
+        let [x, y] = inside_fr_rl(0.01);
+        let com = [x, y, 0.4];
         let o = obs(0.0, &ex, &without_fl, com);
         assert!((o.support_margin(Leg::FrontLeft) - 0.01).abs() < 1e-9);
         let mut t = 0.0;

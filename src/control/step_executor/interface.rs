@@ -7,6 +7,7 @@ use crate::control::foot_contact::ContactConfirmConfig;
 use crate::control::path_follower::FollowerConfig;
 use crate::control::wheels::{WheelKinematics, WheelPairCommand};
 use crate::geometry::Pose2;
+use crate::monitor::MonitorLimits;
 use crate::motion::kinematics::support_centroid;
 use crate::params::Params;
 use crate::robot::Leg;
@@ -27,8 +28,18 @@ pub struct ExecutorConfig {
     /// stays above the threshold only if it starts this much higher. From
     /// `Params::lift_margin_reserve_m` (3 cm), which the motion generator asks too.
     pub lift_margin_reserve_m: f64,
-    /// With a foot in the air, a support margin below this puts the foot down, m.
+    /// With a foot in the air, a support margin below this for `emergency_hold_s` puts
+    /// the foot down, m.
     pub emergency_margin_m: f64,
+    /// How long the support margin must stay below `emergency_margin_m` before the foot
+    /// is put down, s: the monitor's support memory plus its margin hold
+    /// (`MonitorLimits::support_memory_s` + `MonitorLimits::margin_hold_s`, 0.08 s), so
+    /// that a dip the monitor does not count as a loss of margin (a far support wheel
+    /// bouncing as the foot unloads: measured on a steep climb, the front-left pair off
+    /// the ground under 0.1 s as the rear-right foot lifted) does not put a foot down and
+    /// make its step ask 3 cm more. A robot tipping from rest turns by about
+    /// g·d/h² · t²/2, 5 mrad in that time for a CoM 5 cm out at 0.6 m.
+    pub emergency_hold_s: f64,
     /// Time the posture is held before the margin is measured for a lift, s.
     pub lift_settle_s: f64,
     /// Integral gain of the base height hold during standing manoeuvres, 1/s. The leg
@@ -66,7 +77,9 @@ pub struct ExecutorConfig {
     pub max_correction_m: f64,
     /// Time over which a correction increment is applied, s.
     pub correction_time_s: f64,
-    /// Correction increments tried before a step is aborted.
+    /// Correction increments that do not pay (each raising the measured margin by less
+    /// than `guard::MIN_CORRECTION_GAIN_M`, 0.8 mm) before a step is aborted; increments
+    /// that pay go on up to `max_correction_m`.
     pub max_correction_attempts: usize,
     /// Retries of a step whose foot had to be put down.
     pub max_step_retries: usize,
@@ -125,6 +138,10 @@ impl ExecutorConfig {
             min_lift_margin_m: params.min_lift_margin_m,
             lift_margin_reserve_m: params.lift_margin_reserve_m,
             emergency_margin_m: params.min_lift_margin_m / 2.0,
+            emergency_hold_s: {
+                let monitor = MonitorLimits::default();
+                monitor.support_memory_s + monitor.margin_hold_s
+            },
             lift_settle_s: 0.3,
             base_hold_gain: 2.0,
             max_base_lift_m: 0.04,
@@ -217,7 +234,9 @@ pub struct Command {
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum ExecFailure {
     /// The support margin stayed below the lift threshold after the corrections.
-    #[error("step of {leg:?} aborted: support margin {margin_m:.3} m below {required_m:.3} m")]
+    #[error(
+        "step of {leg:?} aborted: support margin {margin_m:.3} m below {required_m:.3} m (planned {planned_m:.3} m)"
+    )]
     StepAborted {
         /// The stepping leg.
         leg: Leg,
@@ -225,6 +244,8 @@ pub enum ExecFailure {
         margin_m: f64,
         /// Required margin, m.
         required_m: f64,
+        /// The margin the plan gives the step's lift keyframe, m.
+        planned_m: f64,
     },
     /// A foot found no contact within the extra lowering (after placing: below the
     /// foothold; when put down: below where it was put down from).
@@ -315,6 +336,10 @@ pub enum ExecEventKind {
         leg: Leg,
         /// Support margin measured before lifting, m.
         margin_m: f64,
+        /// The margin the plan gives the lift keyframe (the motion generator's CoM over
+        /// the three planned support feet), m: beside `margin_m`, how far the plan's
+        /// estimate is from MuJoCo's measure.
+        planned_m: f64,
     },
     /// Before a step the feet stood this far from the plan's footholds, and the robot
     /// rolled back onto them (`step_executor::slide`).

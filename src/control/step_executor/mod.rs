@@ -33,7 +33,9 @@
 //!   the measured error along it (the sagittal legs cannot carry it sideways; the guard's
 //!   roll does that), capped at [`ExecutorConfig::max_base_hold_m`] and scaled back every
 //!   tick to what the legs in contact reach, so it never winds up into a foot pulled off
-//!   the ground.
+//!   the ground; before a lift, as for the guard's corrections, the foot about to leave
+//!   the ground does not count (it bounded the hold, which then gave back every
+//!   correction the guard added).
 //! - **Before a step** (the first keyframe of a path element that lifts a foot) the
 //!   stance is brought back onto the plan's footholds if the wheel contacts MuJoCo
 //!   reports put it more than [`ExecutorConfig::slide_threshold_m`] off them: the pairs
@@ -51,8 +53,10 @@
 //!   base tilts each wheel pair onto its lower wheel, `motion::kinematics::wheel_support`).
 //!   If that does not suffice, the step is aborted (the foot is not lifted).
 //! - **While a foot is in the air** the support margin is watched; below
-//!   [`ExecutorConfig::emergency_margin_m`] the foot is put down where it is (lowered until
-//!   MuJoCo reports contact), and the step is retried from the lift (bounded).
+//!   [`ExecutorConfig::emergency_margin_m`] for [`ExecutorConfig::emergency_hold_s`] (what
+//!   the monitor counts as a loss of margin, not a wheel's bounce) the foot is put down
+//!   where it is (lowered until MuJoCo reports contact), and the step is retried from the
+//!   lift (bounded).
 //! - **Stance feet keep the ground** in the same modes: a leg the posture has bearing
 //!   weight whose wheels touch nothing is lowered until they do (bounded,
 //!   [`ExecutorConfig::max_leg_extension_m`]; the support legs give under a shifted CoM,
@@ -96,6 +100,7 @@ mod test_support;
 mod timing;
 
 pub use actuation::{reachable_leg_targets, rolling_wheel_speed};
+use guard::Corrections;
 pub use guard::{correction_roll, landing_offset};
 pub use interface::{
     Command, ExecEvent, ExecEventKind, ExecFailure, ExecStatus, ExecutorConfig, Observation,
@@ -157,7 +162,7 @@ enum Mode {
     Guard {
         index: usize,
         wait: f64,
-        attempts: usize,
+        corrections: Corrections,
         corr_from: [f64; 2],
     },
     Confirm {
@@ -224,6 +229,9 @@ pub struct StepExecutor {
     base_hold: [f64; 2],
     last_legs: [[f64; 3]; 4],
     now: f64,
+    /// Since when the support margin of a foot in the air has been below
+    /// `ExecutorConfig::emergency_margin_m`, s.
+    low_margin_since: Option<f64>,
     retries: usize,
     steps_started: usize,
     active: Option<ActiveStep>,
@@ -273,6 +281,7 @@ impl StepExecutor {
             base_hold: [0.0; 2],
             last_legs,
             now: 0.0,
+            low_margin_since: None,
             retries: 0,
             steps_started: 0,
             active: None,
@@ -439,9 +448,15 @@ impl StepExecutor {
         // reach (or further beyond than the posture itself does) would pull that foot off
         // the ground (`reachable_leg_targets`). The hold is scaled back to what the legs
         // reach, every tick, as the posture moves on; the integral does not wind up.
+        // Before a lift, as for the guard's corrections (`StepExecutor::within_reach`),
+        // the foot about to leave the ground does not bound the hold.
+        let lifting = match self.mode {
+            Mode::Guard { index, .. } => self.keys[index].leg,
+            _ => None,
+        };
         let excess = |a: f64| {
             let h = a * held;
-            reach_excess(&self.robot, &held_by(&p, [h * cy, h * sy]), REACH_SPARE_M, None)
+            reach_excess(&self.robot, &held_by(&p, [h * cy, h * sy]), REACH_SPARE_M, lifting)
         };
         let held = held * reachable_fraction(excess, excess(0.0).max(0.0));
         self.base_hold = [held * cy, held * sy];
@@ -477,8 +492,8 @@ impl StepExecutor {
             Mode::Slide { index, start, rolls, roll, elapsed, rolling } => {
                 self.slide_tick(obs, dt, index, start, rolls, roll, elapsed, rolling)
             }
-            Mode::Guard { index, wait, attempts, corr_from } => {
-                self.guard_tick(obs, dt, index, wait, attempts, corr_from)
+            Mode::Guard { index, wait, corrections, corr_from } => {
+                self.guard_tick(obs, dt, index, wait, corrections, corr_from)
             }
             Mode::Confirm { index, confirm } => self.confirm_tick(obs, dt, index, confirm),
             Mode::PutDown { leg, lowered, floor, confirm, then } => {

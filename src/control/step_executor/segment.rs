@@ -105,7 +105,13 @@ impl StepExecutor {
         {
             let m = obs.support_margin(l);
             let airborne = phase != Phase::Place || !obs.leg_in_contact(l);
-            if airborne && m < self.config.emergency_margin_m {
+            let low = airborne && m < self.config.emergency_margin_m;
+            self.low_margin_since = if low { self.low_margin_since.or(Some(time)) } else { None };
+            let held = self
+                .low_margin_since
+                .is_some_and(|since| time - since + dt >= self.config.emergency_hold_s - 1e-9);
+            if held {
+                self.low_margin_since = None;
                 self.event(time, ExecEventKind::FootPutDown { leg: l, margin_m: m });
                 let lift = self.lift_index(index);
                 let then = if self.retries < self.config.max_step_retries {
@@ -118,6 +124,7 @@ impl StepExecutor {
                         leg: l,
                         margin_m: m,
                         required_m: self.config.min_lift_margin_m,
+                        planned_m: self.keys[lift].margin_m,
                     })
                 };
                 self.start_put_down(l, then);
