@@ -163,7 +163,7 @@ impl StepExecutor {
 mod tests {
     use crate::control::step_executor::actuation::{REACH_SPARE_M, reach_excess};
     use crate::control::step_executor::test_support::{
-        all_contacts, config, ground, key, obs, robot, standing, step_path,
+        all_contacts, config, contacts_without, ground, key, obs, robot, standing, step_path,
     };
     use crate::control::step_executor::{
         ExecEventKind, ExecFailure, ExecStatus, ExecutorConfig, Mode, StepExecutor,
@@ -179,8 +179,7 @@ mod tests {
         let feet = keys[0].feet;
         // The CoM 0.14 m inside the FR–RL diagonal (which passes through the origin).
         let com = [-0.1, -0.1, 0.4];
-        let without_fl: Vec<_> =
-            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        let without_fl = contacts_without(&feet, Leg::FrontLeft);
         let mut t = 0.0;
         let mut lifted_at = None;
         let mut status = ExecStatus::Running;
@@ -232,8 +231,7 @@ mod tests {
         assert!((config().emergency_hold_s - 0.08).abs() < 1e-12);
         let keys = step_path();
         let feet = keys[0].feet;
-        let without_fl: Vec<_> =
-            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        let without_fl = contacts_without(&feet, Leg::FrontLeft);
         // The CoM 0.14 m inside the FR–RL diagonal; a dip is the rear-left pair off the
         // ground (FR and RR left: the CoM is 0.22 m outside their line).
         let com = [-0.1, -0.1, 0.4];

@@ -7,8 +7,8 @@
 //! Increments go on while they pay: the step is aborted after
 //! `ExecutorConfig::max_correction_attempts` increments that each raised the measured
 //! margin by less than [`MIN_CORRECTION_GAIN_M`] ([`Corrections`]), or when the legs'
-//! reach or `ExecutorConfig::max_correction_m` leaves no increment. At the lift the landing offset ([`landing_offset`]) of the
-//! swing foot is frozen.
+//! reach or `ExecutorConfig::max_correction_m` leaves no increment. At the lift the
+//! landing offset ([`landing_offset`]) of the swing foot is frozen.
 
 use super::actuation::{REACH_SPARE_M, reach_excess, reachable_fraction};
 use super::timing::smoothstep;
@@ -253,7 +253,7 @@ impl StepExecutor {
 mod tests {
     use super::*;
     use crate::control::step_executor::test_support::{
-        all_contacts, config, ground, obs, robot, standing, step_path,
+        config, contacts_without, ground, obs, robot, standing, step_path,
     };
     use crate::control::step_executor::{ExecStatus, ExecutorConfig};
 
@@ -322,8 +322,7 @@ mod tests {
         let keys = step_path();
         let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
         let feet = keys[0].feet;
-        let without_fl: Vec<_> =
-            all_contacts(&feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
+        let without_fl = contacts_without(&feet, Leg::FrontLeft);
         let com = [-0.1, -0.1, 0.4];
         let mut t = 0.0;
         while ex.active_step().is_none() && t < 2.0 {
@@ -345,9 +344,7 @@ mod tests {
         let keys = step_path();
         let cfg = ExecutorConfig { max_correction_m: 0.2, ..config() };
         let ex = StepExecutor::new(&robot(), cfg, keys.clone(), ground());
-        let without_fl =
-            all_contacts(&keys[0].feet).into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
-        (ex, without_fl)
+        (ex, contacts_without(&keys[0].feet, Leg::FrontLeft))
     }
 
     /// The point `d` inside the FR–RL diagonal of [`step_path`]'s stance (the line
@@ -386,11 +383,9 @@ mod tests {
             [com0[0] + 0.3 * ex.correction[0], com0[1] + 0.3 * ex.correction[1], 0.4]
         };
         let mut t = 0.0;
-        let mut margins = Vec::new();
         while ex.active_step().is_none() && ex.steps_aborted == 0 && t < 60.0 {
             t += 0.01;
             let o = obs(t, &ex, &without_fl, com(&ex));
-            margins.push(o.support_margin(Leg::FrontLeft));
             ex.tick(&o, 0.01);
         }
         let corrections: Vec<f64> = ex

@@ -89,6 +89,11 @@ pub(super) fn all_contacts(feet: &[[f64; 3]; 4]) -> Vec<(Leg, [f64; 2])> {
     Leg::ALL.iter().map(|&l| (l, [feet[l.index()][0], feet[l.index()][1]])).collect()
 }
 
+/// [`all_contacts`] but those of `lifted`.
+pub(super) fn contacts_without(feet: &[[f64; 3]; 4], lifted: Leg) -> Vec<(Leg, [f64; 2])> {
+    all_contacts(feet).into_iter().filter(|(l, _)| *l != lifted).collect()
+}
+
 pub(super) fn ground() -> HeightMap {
     HeightMap::filled([-2.0, -2.0], 0.025, 160, 160, 0.0).unwrap()
 }
