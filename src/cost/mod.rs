@@ -89,6 +89,17 @@ pub enum CostError {
 /// the leg capsule's 2.5 cm radius and the half cell a point may sit off its cell centre).
 pub const LEG_TERRAIN_CELLS: usize = 2;
 
+/// Cell offsets of a driving pose's look-ups for one yaw ([`CostMaps::driving_stencil`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DrivingStencil {
+    /// Each foot's cell (FL, FR, RL, RR), `[di, dj]` from the base's.
+    feet: [[isize; 2]; 4],
+    /// Each base circle's cell.
+    circles: [[isize; 2]; 2],
+    /// The feet's heading bin (the base's yaw).
+    bin: HeadingBin,
+}
+
 /// Height map, precomputed cost layers, weights and robot geometry: everything needed to
 /// answer cost queries for any pose on one map.
 #[derive(Debug, Clone)]
@@ -380,26 +391,28 @@ impl CostMaps {
                 None => return Cost::Unknown,
             }
         }
-        let (s, c) = pose.theta.sin_cos();
-        self.body_cost_from_ground(pose, (s, c), ground, leg_heights)
+        self.body_cost_under(self.circle_cells(pose, pose.theta.sin_cos()), ground, leg_heights)
     }
 
-    /// Eq. 3 once the feet's ground heights are known (all finite); `(s, c)` is the sine
-    /// and cosine of the pose's yaw.
+    /// The cells holding the two base circles' centres at `pose` (`(s, c)` the sine and
+    /// cosine of its yaw); `None` off the map.
     #[inline]
-    fn body_cost_from_ground(
+    fn circle_cells(&self, pose: &Pose2, (s, c): (f64, f64)) -> [Option<(usize, usize)>; 2] {
+        self.body.circle_x.map(|cx| self.heights.cell_of(pose.x + c * cx, pose.y + s * cx))
+    }
+
+    /// Eq. 3 once the feet's ground heights are known (all finite), with the base
+    /// circles' centres in `circles`.
+    #[inline]
+    fn body_cost_under(
         &self,
-        pose: &Pose2,
-        (s, c): (f64, f64),
+        circles: [Option<(usize, usize)>; 2],
         ground: [f64; 4],
         leg_heights: &[f64; 4],
     ) -> Cost {
         let mut under = [0.0; 2];
-        for (u, &cx) in under.iter_mut().zip(&self.body.circle_x) {
-            let Some((i, j)) = self.heights.cell_of(pose.x + c * cx, pose.y + s * cx) else {
-                return Cost::Unknown;
-            };
-            match self.disc_max.get(i, j) {
+        for (u, cell) in under.iter_mut().zip(circles) {
+            match cell.and_then(|(i, j)| self.disc_max.get(i, j)) {
                 Some(h) => *u = h,
                 None => return Cost::Unknown,
             }
@@ -433,19 +446,30 @@ impl CostMaps {
         feet: &[[f64; 2]; 4],
         leg_heights: &[f64; 4],
     ) -> PoseCost {
-        // One cell look-up per foot serves both its C_F and its ground height. The feet's
-        // heading is the base's: the neutral footprint and the step stances stand with
-        // straight wheels.
+        let cells = feet
+            .map(|[x, y]| self.heights.cell_of(x, y).and_then(|(i, j)| self.heights.index(i, j)));
+        // The feet's heading is the base's: the neutral footprint and the step stances
+        // stand with straight wheels.
         let bin = self.foot.heading_bin(pose.theta);
+        self.pose_cost_of_cells(cells, bin, || self.circle_cells(pose, sc), leg_heights)
+    }
+
+    /// Eq. 4 from the feet's cells (`None` off the map), the feet's heading bin and the
+    /// base circles' cells (asked for only where every foot's ground is known).
+    #[inline]
+    fn pose_cost_of_cells(
+        &self,
+        cells: [Option<usize>; 4],
+        bin: HeadingBin,
+        circles: impl FnOnce() -> [Option<(usize, usize)>; 2],
+        leg_heights: &[f64; 4],
+    ) -> PoseCost {
+        // One cell look-up per foot serves both its C_F and its ground height.
         let mut feet_cost = [Cost::Unknown; 4];
         let mut ground = [0.0; 4];
         let mut ground_known = true;
         for k in 0..4 {
-            let cell = self
-                .heights
-                .cell_of(feet[k][0], feet[k][1])
-                .and_then(|(i, j)| self.heights.index(i, j));
-            match cell {
+            match cells[k] {
                 Some(idx) => {
                     let [cf, h] = self.foot_cells[idx];
                     let cf = if self.foot_oriented { self.foot.raw_at(idx, bin) } else { cf };
@@ -460,7 +484,7 @@ impl CostMaps {
             }
         }
         let body = if ground_known {
-            self.body_cost_from_ground(pose, sc, ground, leg_heights)
+            self.body_cost_under(circles(), ground, leg_heights)
         } else {
             Cost::Unknown
         };
@@ -483,6 +507,46 @@ impl CostMaps {
             .neutral_footprint
             .map(|[fx, fy]| [pose.x + c * fx - s * fy, pose.y + s * fx + c * fy]);
         self.pose_cost_sc(pose, (s, c), &feet, &[self.driving_leg_height; 4]).total
+    }
+
+    /// Where the look-ups of [`CostMaps::driving_pose_cost`] fall, in whole cells from
+    /// the base's cell, for a pose at a cell centre with yaw `theta`: a point `d` from a
+    /// cell's centre lies `⌊1/2 + d / res⌋` cells away, the same for every cell. `None`
+    /// where a look-up point lies within 10⁻⁶ of a cell border (float rounding could
+    /// then put it in either cell: ask `driving_pose_cost` instead).
+    pub fn driving_stencil(&self, theta: f64) -> Option<DrivingStencil> {
+        let (s, c) = theta.sin_cos();
+        let res = self.heights.resolution();
+        let shift = |d: f64| -> Option<isize> {
+            let q = 0.5 + d / res;
+            let k = q.floor();
+            (q - k > 1e-6 && k + 1.0 - q > 1e-6).then_some(k as isize)
+        };
+        let cell = |dx: f64, dy: f64| Some([shift(dx)?, shift(dy)?]);
+        let mut feet = [[0; 2]; 4];
+        for (f, &[fx, fy]) in feet.iter_mut().zip(&self.neutral_footprint) {
+            *f = cell(c * fx - s * fy, s * fx + c * fy)?;
+        }
+        let mut circles = [[0; 2]; 2];
+        for (o, &cx) in circles.iter_mut().zip(&self.body.circle_x) {
+            *o = cell(c * cx, s * cx)?;
+        }
+        Some(DrivingStencil { feet, circles, bin: self.foot.heading_bin(theta) })
+    }
+
+    /// [`CostMaps::driving_pose_cost`] of the pose at the centre of cell (i, j) with the
+    /// yaw `stencil` was made for: the same value, from integer look-ups.
+    #[inline]
+    pub fn driving_pose_cost_at(&self, i: usize, j: usize, stencil: &DrivingStencil) -> Cost {
+        let (nx, ny) = self.heights.dims();
+        let at = |[di, dj]: [isize; 2]| {
+            let (a, b) = (i.wrapping_add_signed(di), j.wrapping_add_signed(dj));
+            (a < nx && b < ny).then_some((a, b))
+        };
+        let cells = stencil.feet.map(|d| at(d).map(|(a, b)| b * nx + a));
+        let circles = || stencil.circles.map(at);
+        let legs = [self.driving_leg_height; 4];
+        self.pose_cost_of_cells(cells, stencil.bin, circles, &legs).total
     }
 
     /// Number of cells with infinite foot cost.
@@ -559,6 +623,58 @@ mod tests {
             body_mass: 30.0,
             body_com: [0.0, 0.0, 0.2],
             leg_segment_masses: [2.0, 1.5, 1.5],
+        }
+    }
+
+    #[test]
+    fn a_driving_stencil_holds_the_cells_a_point_d_from_a_centre_falls_in() {
+        let maps = maps_of(&[]);
+        // Feet at x' = ±0.45 m (18.5 → 18, −17.5 → −18 cells), y' = ±0.2 m (8.5 → 8,
+        // −7.5 → −8); circles at x' = ±0.2 m (8, −8).
+        let s = maps.driving_stencil(0.0).expect("no point on a border");
+        assert_eq!(s.feet, [[18, 8], [18, -8], [-18, 8], [-18, -8]]);
+        assert_eq!(s.circles, [[8, 0], [-8, 0]]);
+        // Facing +y: x = −y', y = x'.
+        let s = maps.driving_stencil(std::f64::consts::FRAC_PI_2).expect("no border");
+        assert_eq!(s.feet, [[-8, 18], [8, 18], [-8, -18], [8, -18]]);
+        // Feet at x' = ±0.4375 m lie 17.5 cells out: on a border, so no stencil.
+        let mut r = robot();
+        r.neutral_foot_offset_x = [0.1375, 0.1375, -0.1375, -0.1375];
+        let m = rasterise(&[], [0.0, 0.0], [5.0, 5.0], RES).unwrap();
+        let maps = CostMaps::build(&m, &r, &Params::default()).unwrap();
+        assert_eq!(maps.driving_stencil(0.0), None);
+    }
+
+    #[test]
+    fn a_driving_stencil_gives_the_driving_pose_cost_bit_for_bit() {
+        let prims = [
+            Primitive::Box { center: [1.2, 0.9], size: [0.6, 0.5], height: 0.2, yaw_deg: 17.0 },
+            Primitive::Box { center: [2.3, 0.5], size: [0.3, 0.3], height: 0.06, yaw_deg: 0.0 },
+            Primitive::Pole { center: [0.7, 1.4], radius: 0.05, height: 0.12 },
+        ];
+        let m = rasterise(&prims, [0.0, 0.0], [3.0, 2.0], RES).unwrap();
+        let robot = RobotDescription::reference();
+        for foot_model in [FootModel::Paper, FootModel::WheelPair] {
+            let maps =
+                CostMaps::build(&m, &robot, &Params { foot_model, ..Params::default() }).unwrap();
+            let (nx, ny) = m.dims();
+            let mut stencils = 0;
+            for k in 0..64 {
+                let theta =
+                    crate::geometry::wrap_angle(f64::from(k) * std::f64::consts::TAU / 64.0);
+                let Some(stencil) = maps.driving_stencil(theta) else { continue };
+                stencils += 1;
+                for j in 0..ny {
+                    for i in 0..nx {
+                        let [x, y] = m.cell_center(i, j);
+                        let exact = maps.driving_pose_cost(&Pose2::new(x, y, theta));
+                        let fast = maps.driving_pose_cost_at(i, j, &stencil);
+                        assert_eq!(fast, exact, "{foot_model:?} ({i}, {j}) at {k}");
+                    }
+                }
+            }
+            // The map's edges put feet off it (unknown); the test is not vacuous.
+            assert!(stencils >= 60, "{stencils} of 64 yaws have a stencil");
         }
     }
 

@@ -316,6 +316,8 @@ pub struct PlanSummary {
     pub expansions: u64,
     /// States generated.
     pub states: usize,
+    /// The heuristic's own work: its set-up and how far its cost-to-go searched.
+    pub heuristic: HeuristicSummary,
     /// Distinct footprints met.
     pub footprints: usize,
     /// The step-related factor used.
@@ -330,6 +332,18 @@ pub struct PlanSummary {
     /// in a replan).
     #[serde(skip)]
     pub keys: Vec<PoseKey>,
+}
+
+/// What the hybrid graph's heuristic cost (`plan --json`'s `heuristic`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HeuristicSummary {
+    /// Building the step bound and the reachable regions when the graph was made, s
+    /// (before the search; not in `planning_time_s`).
+    pub setup_time_s: f64,
+    /// (Cell, orientation) nodes the lazy cost-to-go settled during the search.
+    pub cost_to_go_nodes: usize,
+    /// Whether the time limit stopped the cost-to-go (its bound was frozen).
+    pub cost_to_go_frozen: bool,
 }
 
 /// Snake-case name of a termination.
@@ -690,6 +704,9 @@ pub fn run(
     let lattice_err = |source| PlanJobError::Lattice { scenario: file(), source };
     let mut graph = prep.graph(robot, neighbourhood, prep.params.k12).map_err(lattice_err)?;
     graph.forbid(&opts.forbidden);
+    // The heuristic's tables are built before the search's clock starts (within the
+    // plan's time limit, which counts from `t0`).
+    let heuristic_setup = graph.heuristic_setup_time();
     let eps0 = opts.initial_epsilon.unwrap_or(prep.params.arastar_initial_epsilon);
     let probe = opts.probe_epsilon.unwrap_or(prep.params.arastar_probe_epsilon);
     let search_params = SearchParams {
@@ -763,6 +780,11 @@ pub fn run(
         termination: termination_name(result.termination),
         expansions: result.expansions,
         states: result.states,
+        heuristic: HeuristicSummary {
+            setup_time_s: heuristic_setup.as_secs_f64(),
+            cost_to_go_nodes: graph.cost_to_go_cells(),
+            cost_to_go_frozen: graph.heuristic_frozen(),
+        },
         footprints: graph.footprint_count(),
         step_cost_factor: prep.params.step_cost_factor,
         foot_model: prep.params.foot_model,

@@ -177,6 +177,7 @@ use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
 use crate::stability::stability_margin;
 use serde::Serialize;
+use std::cell::{Cell, OnceCell};
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
@@ -283,8 +284,11 @@ pub struct HybridConfig {
     pub foot_move_increment_m: f64,
     /// Cap on distinct footprints (graph size guard).
     pub max_footprints: usize,
-    /// Most (cell, orientation) nodes for which the heuristic's cost-to-go keeps one
-    /// layer per orientation (`cost_to_go::MAX_ORIENTED_NODES`); above, one layer.
+    /// Orientation groups of the heuristic's cost-to-go, one layer of nodes each (a
+    /// divisor of the lattice's orientations; see `cost_to_go`).
+    pub cost_to_go_groups: usize,
+    /// Most (cell, group) nodes for which the heuristic's cost-to-go keeps
+    /// `cost_to_go_groups` layers (`cost_to_go::MAX_ORIENTED_NODES`); above, one layer.
     pub max_oriented_nodes: usize,
     /// Smallest stability margin of a posture, m (the generator's requirement).
     pub min_stability_margin_m: f64,
@@ -368,6 +372,7 @@ impl HybridConfig {
             min_support_side_length_m: params.min_support_side_length_m,
             foot_move_increment_m: 0.1,
             max_footprints: 65_536,
+            cost_to_go_groups: super::cost_to_go::ORIENTATION_GROUPS,
             max_oriented_nodes: super::cost_to_go::MAX_ORIENTED_NODES,
             min_stability_margin_m: params.min_stability_margin_m,
             step_support_margin_m: params.step_support_margin_m,
@@ -407,15 +412,28 @@ pub struct ManoeuvreStats {
     pub footprint_table_full: u64,
 }
 
+/// What the hybrid graph's heuristic looks up, built once per graph (at its first use).
+struct HeuristicTables {
+    /// Base cells that can still reach the goal (`reachability`): an infinite heuristic
+    /// elsewhere proves "no path" without searching.
+    regions: BaseRegions,
+    /// The step-cost part (`heuristic`).
+    step_bound: StepBound,
+    /// The driving and base-shift part (`cost_to_go`): a backward Dijkstra over base
+    /// cells, run lazily as far as the queries need.
+    cost_to_go: CostToGo,
+    /// Time spent building the step bound and the regions.
+    setup: Duration,
+}
+
 /// The hybrid graph over one cost map.
 pub struct HybridGraph<'c> {
     maps: &'c CostMaps,
     driving: DrivingGraph<FeasibleDriving<'c>>,
     /// The shared feasibility model (`feasibility`): body clearance of standing states.
     feasibility: DrivingCheck,
-    /// Base cells that can still reach the goal (`reachability`): an infinite heuristic
-    /// elsewhere proves "no path" without searching.
-    regions: BaseRegions,
+    /// The goal the heuristic aims at.
+    goal: DrivingGoal,
     /// Edges the motion generator rejected in an earlier plan (`jobs::run`): left out.
     forbidden: Vec<(PoseKey, PoseKey)>,
     config: HybridConfig,
@@ -438,13 +456,11 @@ pub struct HybridGraph<'c> {
     /// Scratch buffer for the labelled special successors.
     special: Vec<(LatticeState, Cost, Manoeuvre)>,
     stats: ManoeuvreStats,
-    /// The step-cost part of the heuristic (`heuristic`), built once per graph.
-    step_bound: StepBound,
-    /// The driving and base-shift part of the heuristic (`cost_to_go`): a backward
-    /// Dijkstra over base cells, run lazily as far as the queries need.
-    cost_to_go: CostToGo,
-    /// Time spent building `step_bound`.
-    heuristic_setup: Duration,
+    /// The heuristic's tables, built at its first use: a graph asked only for edges
+    /// (`jobs::plan`'s plain-cost graph) never builds them.
+    heuristic: OnceCell<HeuristicTables>,
+    /// The cost-to-go's deadline, for tables built after it was set.
+    heuristic_deadline: Cell<Option<Instant>>,
     /// [`Self::target_ok`] of non-neutral footprints by (cell, orientation, offsets): a
     /// footprint is entered from several predecessors, and each check runs the standing
     /// rule's IK.
@@ -589,30 +605,6 @@ impl<'c> HybridGraph<'c> {
         let trig = (0..lattice.orientations).map(|k| lattice.yaw(k as u8).sin_cos()).collect();
         let foot_move_cells = (config.foot_move_increment_m / res).round().clamp(1.0, 127.0) as i8;
         let near = near_obstacle_layer(maps, config.step_obstacle_distance_m);
-        let t0 = Instant::now();
-        let max_step_cells = reach.iter().map(|r| i32::from(r[1]) - i32::from(r[0])).max();
-        let max_step_length_m = f64::from(max_step_cells.unwrap_or(0).max(0)) * res;
-        let step_bound = build_step_bound(maps, &near, &config, &lattice, goal, max_step_length_m);
-        // A base shift costs at least f · k10 per metre (C_B ≥ 1) and raises the
-        // foot-offset potential by 4 c per cell (`heuristic::offset_potential`).
-        let shift_step =
-            Cost::from_f64_floor(config.step_cost_factor * config.k10 * res * (1.0 - 1e-9))
-                .saturating_add(Cost(step_bound.offset_per_cell().0.saturating_mul(4)));
-        let cost_to_go = CostToGo::new(
-            lattice,
-            &config.driving,
-            shift_step,
-            (goal.i, goal.j, goal.theta),
-            config.max_oriented_nodes,
-        );
-        let regions = BaseRegions::build(
-            maps,
-            robot,
-            &lattice,
-            config.motion.base_circle_radius_m,
-            (goal.i, goal.j),
-        );
-        let heuristic_setup = t0.elapsed();
         let feasibility = DrivingCheck::from_parts(
             robot,
             config.motion.standing,
@@ -629,7 +621,7 @@ impl<'c> HybridGraph<'c> {
                 goal,
             ),
             feasibility,
-            regions,
+            goal,
             forbidden: Vec::new(),
             near,
             config,
@@ -642,9 +634,8 @@ impl<'c> HybridGraph<'c> {
             foot_move_cells,
             special: Vec::with_capacity(16),
             stats: ManoeuvreStats::default(),
-            step_bound,
-            cost_to_go,
-            heuristic_setup,
+            heuristic: OnceCell::new(),
+            heuristic_deadline: Cell::new(None),
             standable: HashMap::default(),
             wheel_move_checks: HashMap::default(),
             base_shift_checks: HashMap::default(),
@@ -652,10 +643,56 @@ impl<'c> HybridGraph<'c> {
         })
     }
 
-    /// Time spent building the heuristic's step bound when the graph was made (not part
-    /// of any search's time).
+    /// The heuristic's tables, built on the first call.
+    fn tables(&self) -> &HeuristicTables {
+        self.heuristic.get_or_init(|| {
+            let t0 = Instant::now();
+            let res = self.lattice.resolution;
+            let max_step_cells = self.reach.iter().map(|r| i32::from(r[1]) - i32::from(r[0])).max();
+            let max_step_length_m = f64::from(max_step_cells.unwrap_or(0).max(0)) * res;
+            let (config, goal) = (&self.config, self.goal);
+            let step_bound = build_step_bound(
+                self.maps,
+                &self.near,
+                config,
+                &self.lattice,
+                goal,
+                max_step_length_m,
+            );
+            // A base shift costs at least f · k10 per metre (C_B ≥ 1) and raises the
+            // foot-offset potential by 4 c per cell (`heuristic::offset_potential`).
+            let shift_step =
+                Cost::from_f64_floor(config.step_cost_factor * config.k10 * res * (1.0 - 1e-9))
+                    .saturating_add(Cost(step_bound.offset_per_cell().0.saturating_mul(4)));
+            let cost_to_go = CostToGo::new(
+                self.lattice,
+                &config.driving,
+                shift_step,
+                (goal.i, goal.j, goal.theta),
+                (config.cost_to_go_groups, config.max_oriented_nodes),
+            );
+            cost_to_go.set_deadline(self.heuristic_deadline.get());
+            let regions = BaseRegions::build(
+                self.maps,
+                &self.robot,
+                &self.lattice,
+                config.motion.base_circle_radius_m,
+                (goal.i, goal.j),
+            );
+            HeuristicTables { regions, step_bound, cost_to_go, setup: t0.elapsed() }
+        })
+    }
+
+    /// Whether the heuristic's tables have been built (by a first heuristic query).
+    #[cfg(test)]
+    pub(crate) fn heuristic_built(&self) -> bool {
+        self.heuristic.get().is_some()
+    }
+
+    /// Time spent building the heuristic's step bound and reachable regions (not part of
+    /// any search's time: `jobs::plan` has them built before it starts the clock).
     pub fn heuristic_setup_time(&self) -> Duration {
-        self.heuristic_setup
+        self.tables().setup
     }
 
     /// The parts of the heuristic of `s` (see [`HeuristicParts`]).
@@ -680,21 +717,22 @@ impl<'c> HybridGraph<'c> {
             behind: Cost::ZERO,
             ahead: Cost::ZERO,
         };
-        if !self.regions.reachable(s.i, s.j) {
+        let tables = self.tables();
+        if !tables.regions.reachable(s.i, s.j) {
             p.reachable = Cost::INFINITY;
             return p;
         }
         p.driving = self.driving.heuristic(s);
         if let Some((o, feet)) = footprint {
-            p.steps = self.step_bound.lower_bound(self.maps, feet);
-            (p.behind, p.ahead) = self.step_bound.offset_potential(o);
+            p.steps = tables.step_bound.lower_bound(self.maps, feet);
+            (p.behind, p.ahead) = tables.step_bound.offset_potential(o);
         }
         if p.steps.is_infinite() {
             // No chain of steps reaches the goal: the cost-to-go need not be searched.
             return p;
         }
-        p.to_go = self.cost_to_go.get(self.maps, s.i, s.j, s.theta);
-        if !self.cost_to_go.oriented() {
+        p.to_go = tables.cost_to_go.get(self.maps, s.i, s.j, s.theta);
+        if !tables.cost_to_go.oriented() {
             // One layer for all orientations: turns are not in it.
             p.to_go = p.to_go.saturating_add(self.driving.turn_heuristic(s));
         }
@@ -729,17 +767,26 @@ impl<'c> HybridGraph<'c> {
     /// Stops the heuristic's cost-to-go from growing after `deadline` (the plan's time
     /// limit): see `CostToGo::set_deadline`.
     pub fn set_heuristic_deadline(&self, deadline: Option<Instant>) {
-        self.cost_to_go.set_deadline(deadline);
+        self.heuristic_deadline.set(deadline);
+        if let Some(tables) = self.heuristic.get() {
+            tables.cost_to_go.set_deadline(deadline);
+        }
     }
 
-    /// Base cells the heuristic's cost-to-go has settled so far.
+    /// Whether the plan's time limit stopped the heuristic's cost-to-go (see
+    /// `CostToGo::set_deadline`).
+    pub fn heuristic_frozen(&self) -> bool {
+        self.heuristic.get().is_some_and(|t| t.cost_to_go.frozen())
+    }
+
+    /// (Cell, orientation) nodes the heuristic's cost-to-go has settled so far.
     pub fn cost_to_go_cells(&self) -> usize {
-        self.cost_to_go.settled()
+        self.heuristic.get().map_or(0, |t| t.cost_to_go.settled())
     }
 
     /// Number of foot components the step bound found (0: no step bound).
     pub fn step_bound_components(&self) -> usize {
-        self.step_bound.components()
+        self.tables().step_bound.components()
     }
 
     /// The lattice.

@@ -287,6 +287,21 @@ mod hybrid {
     }
 
     #[test]
+    fn a_graph_asked_only_for_edges_builds_no_heuristic() {
+        // `jobs::plan` prices a path on a second graph (k12 = 1) through `edge` alone;
+        // it built the step bound and the regions for nothing (~70 ms on the platform).
+        let maps = platform_maps(0.2);
+        let goal = state_on(&maps, 2.0, 0.0, 0.0);
+        let mut g = graph(&maps, goal);
+        let s = state_at(&g, 0.0, 0.0);
+        let t = g.labelled_successors(s).first().expect("a successor").0;
+        assert!(g.edge(s, t).is_some());
+        assert!(!g.heuristic_built());
+        assert!(g.heuristic(s) > Cost::ZERO);
+        assert!(g.heuristic_built());
+    }
+
+    #[test]
     fn manoeuvre_costs_by_hand() {
         let c = config();
         // eq. 5: 0.5 · 0.45 + 0.1 · (3 − 1) + 2.3 · 0.2 = 0.225 + 0.2 + 0.46.
@@ -982,8 +997,9 @@ mod hybrid {
 
         /// Random edges of random small maps: from a random state (any orientation,
         /// neutral or a random footprint), a random walk of four edges, checking
-        /// `h(s) ≤ c(s, t) + h(t)` on every successor on the way; with the cost-to-go
-        /// per orientation or in one layer, the goal's orientation fixed or free.
+        /// `h(s) ≤ c(s, t) + h(t)` on every successor on the way; with the cost-to-go in
+        /// 64, 16, 8 (the default), 2 or one orientation group, the goal's orientation
+        /// fixed or free.
         #[test]
         fn heuristic_is_consistent_on_random_maps(
             boxes in proptest::collection::vec(random_box(), 1..=3),
@@ -991,16 +1007,12 @@ mod hybrid {
             o in proptest::array::uniform4(-12i8..=16),
             neutral in proptest::prelude::any::<bool>(),
             walk in proptest::collection::vec(0usize..1000, 4),
-            one_layer in proptest::prelude::any::<bool>(),
+            groups in proptest::sample::select(vec![64usize, 16, 8, 2, 1]),
             free_goal_theta in proptest::prelude::any::<bool>(),
         ) {
             let maps = random_maps(&boxes);
             let goal = state_on(&maps, 2.0, 0.0, 0.0);
-            // Both forms of the cost-to-go: per orientation, and one layer for all.
-            let cfg = HybridConfig {
-                max_oriented_nodes: if one_layer { 0 } else { usize::MAX },
-                ..config()
-            };
+            let cfg = HybridConfig { cost_to_go_groups: groups, ..config() };
             let target = DrivingGoal {
                 theta: if free_goal_theta { None } else { Some(goal.theta) },
                 ..DrivingGoal::at(goal)

@@ -50,7 +50,10 @@ impl Cost {
 
     /// As [`Cost::from_f64`], rounding *down* (see [`Cost::from_f64_ceil`]).
     pub fn from_f64_floor(units: f64) -> Cost {
-        Self::from_f64_rounded(units, f64::floor)
+        // On positive values the truncating cast is floor, without libm's call (x86-64's
+        // baseline has no rounding instruction): the heuristic's Dijkstra converts every
+        // edge it relaxes.
+        Self::from_f64_rounded(units, |micro| micro)
     }
 
     fn from_f64_rounded(units: f64, round: fn(f64) -> f64) -> Cost {
@@ -60,6 +63,7 @@ impl Cost {
         if units <= 0.0 {
             return Cost::ZERO;
         }
+        // `units > 0` here, so `micro as u64` truncates toward zero, i.e. floors.
         let micro = round(units * Self::SCALE as f64);
         if micro >= u64::MAX as f64 { Cost::INFINITY } else { Cost(micro as u64) }
     }
@@ -141,6 +145,10 @@ mod tests {
         assert_eq!(Cost(2_500_000).to_f64(), 2.5);
         assert_eq!(Cost::from_f64_ceil(0.0000011), Cost(2));
         assert_eq!(Cost::from_f64_floor(0.0000019), Cost(1));
+        assert_eq!(Cost::from_f64_floor(2.9999999), Cost(2_999_999));
+        assert_eq!(Cost::from_f64_floor(-0.5), Cost::ZERO);
+        assert_eq!(Cost::from_f64_floor(1e300), Cost::INFINITY);
+        assert_eq!(Cost::from_f64_floor(f64::INFINITY), Cost::INFINITY);
         assert_eq!(Cost::from_f64_ceil(f64::NAN), Cost::INFINITY);
         assert!(Cost::INFINITY.to_f64().is_infinite());
     }
