@@ -136,7 +136,7 @@ struct Search {
     stencils: Vec<Option<DrivingStencil>>,
     /// Per node (`layer · cells + cell`, cells row-major `j · nx + i`: a layer's cells
     /// lie together, as drive edges join them), its record: see [`NodeRecord`].
-    nodes: Vec<NodeRecord>,
+    nodes: Vec<u128>,
     queue: Buckets,
     /// Nodes settled so far.
     settled: usize,
@@ -401,7 +401,7 @@ impl CostToGo {
 impl Search {
     /// A search with `roots` at distance 0.
     fn new(n: usize, mut queue: Buckets, roots: &[usize]) -> Self {
-        let mut nodes = vec![NodeRecord::UNTOUCHED; n];
+        let mut nodes = vec![0u128; n];
         for &r in roots {
             nodes[r].set_dist(Cost::ZERO);
             queue.push(Cost::ZERO, r as u32);
@@ -427,47 +427,54 @@ impl Search {
 /// row of its layer (three arrays took three cache misses per touched node):
 /// bits 0–63 the tentative distance plus one (0: none yet), bits 64–95 `P` as `f32` bits
 /// (0.0: not computed yet; `P ≥ 1` otherwise, so 0 is never a value), bit 96 settled.
-/// All-zero when untouched, so the allocation is a zeroed one the system hands out lazily.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct NodeRecord(u128);
+/// All-zero when untouched, so `vec![0u128; n]` is a zeroed allocation the system hands
+/// out lazily: pages are touched only where the search goes.
+trait NodeRecord {
+    fn dist(self) -> Cost;
+    /// Sets a finite distance (`d < Cost::INFINITY`, as every relaxed one is).
+    fn set_dist(&mut self, d: Cost);
+    fn pose(self) -> Option<f32>;
+    fn set_pose(&mut self, p: f32);
+    fn done(self) -> bool;
+    fn set_done(&mut self);
+}
 
-impl NodeRecord {
-    const UNTOUCHED: Self = Self(0);
-    const DONE: u128 = 1 << 96;
+/// Bit 96 of a [`NodeRecord`]: settled.
+const DONE: u128 = 1 << 96;
 
+impl NodeRecord for u128 {
     #[inline]
     fn dist(self) -> Cost {
-        match self.0 as u64 {
+        match self as u64 {
             0 => Cost::INFINITY,
             v => Cost(v - 1),
         }
     }
 
-    /// Sets a finite distance (`d < Cost::INFINITY`, as every relaxed one is).
     #[inline]
     fn set_dist(&mut self, d: Cost) {
-        self.0 = (self.0 & !u128::from(u64::MAX)) | u128::from(d.0.saturating_add(1));
+        *self = (*self & !u128::from(u64::MAX)) | u128::from(d.0.saturating_add(1));
     }
 
     #[inline]
     fn pose(self) -> Option<f32> {
-        let v = f32::from_bits((self.0 >> 64) as u32);
+        let v = f32::from_bits((self >> 64) as u32);
         (v != 0.0).then_some(v)
     }
 
     #[inline]
     fn set_pose(&mut self, p: f32) {
-        self.0 = (self.0 & !(u128::from(u32::MAX) << 64)) | (u128::from(p.to_bits()) << 64);
+        *self = (*self & !(u128::from(u32::MAX) << 64)) | (u128::from(p.to_bits()) << 64);
     }
 
     #[inline]
     fn done(self) -> bool {
-        self.0 & Self::DONE != 0
+        self & DONE != 0
     }
 
     #[inline]
     fn set_done(&mut self) {
-        self.0 |= Self::DONE;
+        *self |= DONE;
     }
 }
 
@@ -605,7 +612,7 @@ mod tests {
 
     #[test]
     fn a_node_record_keeps_its_three_fields_apart() {
-        let mut r = NodeRecord::UNTOUCHED;
+        let mut r = 0u128;
         assert_eq!((r.dist(), r.pose(), r.done()), (Cost::INFINITY, None, false));
         r.set_pose(f32::INFINITY);
         r.set_dist(Cost(u64::MAX - 1));
