@@ -236,16 +236,27 @@ mod tests {
         // ground (FR and RR left: the CoM is 0.22 m outside their line).
         let com = [-0.1, -0.1, 0.4];
         let dip: Vec<_> = without_fl.iter().copied().filter(|(l, _)| *l != Leg::RearLeft).collect();
-        // Ticks of 10 ms: a dip of `n` ticks, starting 0.2 s after the lift.
-        let put_down_after = |n: usize| {
+        // Ticks of 10 ms: a dip of `n` ticks, starting `from` ticks after the lift; with
+        // `stale`, the executor starts with the start of a low margin left over (as a
+        // segment that ended while the margin was low leaves it: a drift failure, or a
+        // Place that ended with the foot still in the air). The time of the put-down is
+        // counted from the dip's start.
+        let put_down_after_with = |n: usize, from: usize, stale: bool| {
             let mut ex = StepExecutor::new(&robot(), config(), keys.clone(), ground());
+            if stale {
+                // Left by the segment before; then the step's guard starts (here anew:
+                // `new` started it already, at the same time).
+                ex.low_margin_since = Some(0.0);
+                ex.start_guard(1);
+            }
             let (mut t, mut lifted) = (0.0, None);
             for _ in 0..150 {
                 t += 0.01;
                 let k = lifted.map_or(0, |l: f64| ((t - l) / 0.01).round() as usize);
-                let c = if (20..20 + n).contains(&k) { &dip } else { &without_fl };
+                let dipping = lifted.is_some() && (from..from + n).contains(&k);
+                let c = if dipping { &dip } else { &without_fl };
                 let o = obs(t, &ex, c, com);
-                if (20..20 + n).contains(&k) {
+                if dipping {
                     assert!(o.support_margin(Leg::FrontLeft) < 0.0);
                 }
                 ex.tick(&o, 0.01);
@@ -255,10 +266,11 @@ mod tests {
             }
             let lifted = lifted.expect("lifted");
             ex.events.iter().find_map(|e| match e.event {
-                ExecEventKind::FootPutDown { .. } => Some(e.time_s - (lifted + 0.2)),
+                ExecEventKind::FootPutDown { .. } => Some(e.time_s - (lifted + 0.01 * from as f64)),
                 _ => None,
             })
         };
+        let put_down_after = |n: usize| put_down_after_with(n, 20, false);
         // 70 ms below the emergency margin: the monitor does not count it, nor does the
         // executor.
         assert_eq!(put_down_after(7), None);
@@ -267,6 +279,12 @@ mod tests {
             let at = put_down_after(n).expect("put down");
             assert!((at - 0.07).abs() < 1e-6, "{n}: {at}");
         }
+        // A low margin left over from before the lift counts for nothing, also where the
+        // margin is low from the lift's first sample on: the guard starts the watch afresh
+        // (it once put the foot down at that first sample).
+        assert_eq!(put_down_after_with(3, 1, true), None);
+        let at = put_down_after_with(8, 1, true).expect("put down");
+        assert!((at - 0.07).abs() < 1e-6, "{at}");
     }
 
     #[test]

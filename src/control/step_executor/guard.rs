@@ -92,8 +92,12 @@ impl Corrections {
 
 impl StepExecutor {
     /// Starts the lift guard of keyframe `index` from its beginning: no wait yet, no
-    /// correction attempted, the correction faded from where it stands.
+    /// correction attempted, the correction faded from where it stands, no low margin
+    /// being timed.
     pub(super) fn start_guard(&mut self, index: usize) {
+        // A low margin watched in an earlier segment is not this step's: a segment left
+        // while it was low (a drift failure, a Place ended in the air) kept its start.
+        self.low_margin_since = None;
         self.mode = Mode::Guard {
             index,
             wait: 0.0,
