@@ -112,8 +112,8 @@ pub struct CostToGo {
     group: usize,
     /// Drive moves `(di, dj)`.
     moves: Vec<(i32, i32)>,
-    /// `L · k_Δθ` per (layer, move), row-major by layer: the driving graph's move
-    /// weights, or `L` (k_Δθ ≥ 1) with one layer.
+    /// `L · k_Δθ` per (layer, move), row-major by layer: the least of the driving graph's
+    /// move weights over the layer's orientations.
     move_weight: Vec<f64>,
     /// Wheel travel of one orientation step, m (turn edges between layers).
     turn_length: f64,
@@ -264,7 +264,8 @@ impl CostToGo {
         self.search.borrow().frozen.is_some()
     }
 
-    /// Whether the search has one layer per orientation (else: one for all).
+    /// Whether the search has more than one orientation group (else: one for all, and no
+    /// turn edges).
     pub fn oriented(&self) -> bool {
         self.layers > 1
     }
