@@ -337,8 +337,8 @@ pub struct PlanSummary {
 /// What the hybrid graph's heuristic cost (`plan --json`'s `heuristic`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct HeuristicSummary {
-    /// Building the step bound and the reachable regions when the graph was made, s
-    /// (before the search; not in `planning_time_s`).
+    /// Building the step bound and the reachable regions, s (at the heuristic's first
+    /// use, which `plan` makes before the search: not in `planning_time_s`).
     pub setup_time_s: f64,
     /// (Cell, orientation) nodes the lazy cost-to-go settled during the search.
     pub cost_to_go_nodes: usize,
@@ -782,7 +782,7 @@ pub fn run(
         states: result.states,
         heuristic: HeuristicSummary {
             setup_time_s: heuristic_setup.as_secs_f64(),
-            cost_to_go_nodes: graph.cost_to_go_cells(),
+            cost_to_go_nodes: graph.cost_to_go_nodes(),
             cost_to_go_frozen: graph.heuristic_frozen(),
         },
         footprints: graph.footprint_count(),

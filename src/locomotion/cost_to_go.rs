@@ -327,13 +327,11 @@ impl CostToGo {
             // are skipped.
             let Some(c) = search.queue.pop() else { return };
             let c = c as usize;
-            let r = search.nodes[c];
-            if r.done() || !search.queue.holds(r.dist()) {
+            let d = search.nodes[c].dist();
+            if search.nodes[c].done() || !search.queue.holds(d) {
                 continue;
             }
-            let record = &mut search.nodes[c];
-            let d = record.dist();
-            record.set_done();
+            search.nodes[c].set_done();
             search.settled += 1;
             let (t, cell) = (c / cells, c % cells);
             let layer = t * cells;

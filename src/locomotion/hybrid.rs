@@ -432,8 +432,6 @@ pub struct HybridGraph<'c> {
     driving: DrivingGraph<FeasibleDriving<'c>>,
     /// The shared feasibility model (`feasibility`): body clearance of standing states.
     feasibility: DrivingCheck,
-    /// The goal the heuristic aims at.
-    goal: DrivingGoal,
     /// Edges the motion generator rejected in an earlier plan (`jobs::run`): left out.
     forbidden: Vec<(PoseKey, PoseKey)>,
     config: HybridConfig,
@@ -621,7 +619,6 @@ impl<'c> HybridGraph<'c> {
                 goal,
             ),
             feasibility,
-            goal,
             forbidden: Vec::new(),
             near,
             config,
@@ -650,7 +647,7 @@ impl<'c> HybridGraph<'c> {
             let res = self.lattice.resolution;
             let max_step_cells = self.reach.iter().map(|r| i32::from(r[1]) - i32::from(r[0])).max();
             let max_step_length_m = f64::from(max_step_cells.unwrap_or(0).max(0)) * res;
-            let (config, goal) = (&self.config, self.goal);
+            let (config, goal) = (&self.config, self.driving.goal());
             let step_bound = build_step_bound(
                 self.maps,
                 &self.near,
@@ -780,7 +777,7 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// (Cell, orientation) nodes the heuristic's cost-to-go has settled so far.
-    pub fn cost_to_go_cells(&self) -> usize {
+    pub fn cost_to_go_nodes(&self) -> usize {
         self.heuristic.get().map_or(0, |t| t.cost_to_go.settled())
     }
 
