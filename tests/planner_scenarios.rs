@@ -6,6 +6,7 @@
 //! detour and the steps differ by a few percent), so they run ARA* to ε = 1; the others
 //! use ARA* with a time limit.
 
+use momaro::geometry::Pose2;
 use momaro::jobs::plan::{
     self, PathElement, PathKind, PlanJobError, PlanOptions, PlanSummary, run,
 };
@@ -280,6 +281,35 @@ fn two_runs_give_identical_paths() {
     assert_eq!(a.cost, b.cost);
 }
 
+/// A run's retries and replans plan on one prepared world (`plan::run_on`): the second
+/// plan takes the heuristic's tables over from the first and finds what a plan of its
+/// own finds.
+#[test]
+fn plans_on_one_prepared_world_share_its_heuristic_and_find_the_same_path() {
+    let s = scenario("platform");
+    let robot = robot();
+    let opts = first_solution();
+    let alone = plan(&s, &opts);
+    let prep = plan::prepare_for(&s, &robot, &opts).expect("maps");
+    let first = plan::run_on(&prep, &s, &robot, &opts).expect("plan");
+    let again = plan::run_on(&prep, &s, &robot, &opts).expect("plan");
+    assert!(!alone.heuristic.reused && !first.heuristic.reused);
+    assert!(again.heuristic.reused);
+    assert_eq!(again.heuristic.setup_time_s, 0.0);
+    assert!(again.heuristic.cost_to_go_nodes >= first.heuristic.cost_to_go_nodes);
+    for p in [&first, &again] {
+        assert_eq!(p.path, alone.path);
+        assert_eq!(p.cost, alone.cost);
+        assert_eq!(p.expansions, alone.expansions);
+    }
+    // A world prepared with other parameters is refused.
+    let other = PlanOptions { k12: Some(1.0), ..opts };
+    assert!(matches!(
+        plan::run_on(&prep, &s, &robot, &other),
+        Err(PlanJobError::BadOption { option: "prepared", .. })
+    ));
+}
+
 #[test]
 fn a_replan_starts_from_the_nearest_pose_a_plan_can_start_from() {
     let base = std::fs::read_to_string(scenario_path("flat")).expect("read");
@@ -294,18 +324,22 @@ fn a_replan_starts_from_the_nearest_pose_a_plan_can_start_from() {
         plan::prepare(&walled, &robot, None, None, None),
         Err(PlanJobError::Untraversable { .. })
     ));
-    let start = plan::nearest_start(&walled, &robot, &PlanOptions::default(), 0.15).expect("maps");
+    // The run's world is prepared from a start clear of the wall; the robot then stops
+    // at the scenario's start, next to it.
+    let mut clear = walled.clone();
+    clear.start = Pose2::new(walled.start.x, walled.start.y - 0.3, walled.start.theta);
+    let mut prep = plan::prepare(&clear, &robot, None, None, None).expect("clear of the wall");
+    assert!(matches!(
+        prep.set_start(&walled, &robot, walled.start),
+        Err(PlanJobError::Untraversable { which: "start", .. })
+    ));
+    let start = plan::nearest_start(&prep, &robot, walled.start, 0.15);
     let moved = start.distance(&walled.start);
     assert!(moved > 0.0 && moved <= 0.15 + 1e-9, "moved {moved}");
-    let mut from_there = walled.clone();
-    from_there.start = start;
-    plan::prepare(&from_there, &robot, None, None, None).expect("a plan starts there");
+    prep.set_start(&walled, &robot, start).expect("a plan starts there");
+    assert_eq!(prep.start, prep.lattice.state(&start).expect("on the map"));
     // Where a plan can start, the start is kept.
-    let flat = parse(&base);
-    assert_eq!(
-        plan::nearest_start(&flat, &robot, &PlanOptions::default(), 0.15).expect("maps"),
-        flat.start
-    );
+    assert_eq!(plan::nearest_start(&prep, &robot, clear.start, 0.15), clear.start);
 }
 
 #[test]

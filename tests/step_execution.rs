@@ -83,7 +83,8 @@ fn execute_prefix(sc: &Scenario, end: End, push: Option<Push>) -> RunSummary {
     let wall = Instant::now();
     let mut sim = Simulation::new(sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
-    let plan = plan::run(sc, &robot, &plan_options()).expect("plan");
+    let mut prep = plan::prepare_for(sc, &robot, &plan_options()).expect("maps");
+    let plan = plan::run_on(&prep, sc, &robot, &plan_options()).expect("plan");
     let mut end = prefix_end(&plan, end);
     assert!(end < plan.path.len(), "the prefix ends before the goal");
     // Without the planned base shift that prepares a rear step up: it moves the base
@@ -97,7 +98,8 @@ fn execute_prefix(sc: &Scenario, end: End, push: Option<Push>) -> RunSummary {
     momaro::jobs::stand_at_start(&mut sim, sc).expect("stands");
     let opts =
         RunOptions { max_replans: 0, push, ..RunOptions::new(plan_options(), common::model()) };
-    let s = run::execute(sc, &mut sim, Mission { plan, detailed }, &opts, wall).expect("runs");
+    let mission = Mission { plan, detailed };
+    let s = run::execute(sc, &mut prep, &mut sim, mission, &opts, wall).expect("runs");
     println!(
         "{}: {} of {} steps, {} aborted, min margin {:.3} m, steps {:?}, sim {:.1} s, wall {:.1} s, RTF {:.1}, failure {:?}",
         sc.name,
@@ -428,7 +430,10 @@ fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) 
     let detailed =
         run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
     momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
-    let s = run::execute(&sc, &mut sim, Mission { plan, detailed }, &opts, wall).expect("runs");
+    // Replans (if any) plan with the executor's parameters.
+    let mut prep = plan::prepare_for(&sc, &robot, &plan_options()).expect("maps");
+    let mission = Mission { plan, detailed };
+    let s = run::execute(&sc, &mut prep, &mut sim, mission, &opts, wall).expect("runs");
     (s, sim)
 }
 

@@ -42,8 +42,9 @@ pub fn run(
     opts: &PlanOptions,
 ) -> Result<DetailedSummary, DetailedJobError> {
     let robot = sim.robot().clone();
-    let plan = plan::run(scenario, &robot, opts)?;
-    let detailed = expand(scenario, sim, &plan)?;
+    let prep = plan::prepare_for(scenario, &robot, opts)?;
+    let plan = plan::run_on(&prep, scenario, &robot, opts)?;
+    let detailed = expand_prefix_on(&prep, scenario, sim, &plan, plan.path.len())?;
     Ok(DetailedSummary { plan, detailed })
 }
 
@@ -78,6 +79,21 @@ pub fn expand_prefix(
         Some(plan.step_cost_factor),
         Some(plan.foot_model),
     )?;
+    expand_prefix_on(&prep, scenario, sim, plan, end)
+}
+
+/// [`expand_prefix`] on the world `prep` the plan was made on (`plan::run_on`).
+///
+/// # Errors
+/// [`DetailedJobError::Motion`] if the expansion fails.
+pub fn expand_prefix_on(
+    prep: &plan::Prepared,
+    scenario: &Scenario,
+    sim: &mut Simulation,
+    plan: &PlanSummary,
+    end: usize,
+) -> Result<DetailedPath, DetailedJobError> {
+    let robot = sim.robot().clone();
     let options = MotionOptions::from_params(&prep.params);
     let end = end.min(plan.path.len());
     expand_path(&plan.path[..end], &robot, &prep.maps, sim, &options)

@@ -2,12 +2,15 @@
 //! 2017, Sec. V, VII) run on a scenario, as library functions returning serialisable
 //! summaries.
 //!
-//! [`run`] rasterises the scenario's terrain to a height map (2.5 cm), builds the cost
-//! maps (Sec. IV), checks the start and goal poses, and searches the hybrid graph
-//! (`locomotion::hybrid`) with A* (16-neighbourhood) or ARA* (20-neighbourhood, ε from
-//! 3 decaying to 1), as the paper does. The time limit covers everything after option
-//! checking: map and cost-map building count against it, and the search gets what is
-//! left, so a call never takes much longer than the limit. With
+//! [`prepare`] rasterises the scenario's terrain to a height map (2.5 cm), builds the cost
+//! maps (Sec. IV) and checks the start and goal poses: a [`Prepared`] world, built once
+//! per job. [`run_on`] searches its hybrid graph (`locomotion::hybrid`) with A*
+//! (16-neighbourhood) or ARA* (20-neighbourhood, ε from 3 decaying to 1), as the paper
+//! does; the plans of one job (`run`'s retries and replans) share the world and the
+//! heuristic's tables toward its goal ([`HeuristicCache`]). [`run`] does both. The time
+//! limit covers everything after option checking: map and cost-map building count
+//! against it, and the search gets what is left, so a call never takes much longer than
+//! the limit. With
 //! [`PlanOptions::expansion_image`] the expansions per base cell are counted and drawn
 //! (`cost_image::expansion_image`), whether a path was found or not.
 //!
@@ -24,8 +27,8 @@
 use crate::cost::{Cost as CostValue, CostError, CostMaps};
 use crate::geometry::Pose2;
 use crate::locomotion::{
-    Algorithm, DrivingGoal, HybridConfig, HybridGraph, LatticeError, LatticeState, ManoeuvreKind,
-    Neighbourhood, PoseKey, StepCost,
+    Algorithm, DrivingGoal, HeuristicCache, HybridConfig, HybridGraph, Lattice, LatticeError,
+    LatticeState, ManoeuvreKind, Neighbourhood, PoseKey, StepCost,
 };
 use crate::params::{FootModel, InvalidParam, Params};
 use crate::planner::{
@@ -344,6 +347,9 @@ pub struct HeuristicSummary {
     pub cost_to_go_nodes: usize,
     /// Whether the time limit stopped the cost-to-go (its bound was frozen).
     pub cost_to_go_frozen: bool,
+    /// Whether an earlier plan of the job built the tables toward this goal (a retry or a
+    /// replan): then `setup_time_s` is zero and `cost_to_go_nodes` counts its nodes too.
+    pub reused: bool,
 }
 
 /// Snake-case name of a termination.
@@ -366,19 +372,23 @@ fn algorithm_name(a: Algorithm) -> &'static str {
     }
 }
 
-/// Cost maps, lattice states of start and goal and the parameters of one scenario: what
-/// every search of a job shares.
+/// Cost maps, lattice states of start and goal and the parameters of one scenario, and
+/// the heuristic tables the job's searches built: what every search of a job shares.
 pub struct Prepared {
     /// The parameters with the options' overrides.
     pub params: Params,
     /// The cost client.
     pub maps: CostMaps,
+    /// The lattice over the maps.
+    pub lattice: Lattice,
     /// Start state (neutral footprint).
     pub start: LatticeState,
     /// Goal state (neutral footprint).
     pub goal: LatticeState,
     /// Time spent building, s.
     pub setup_time_s: f64,
+    /// The heuristic tables of the searches on these maps ([`run_on`]'s graphs).
+    pub heuristics: HeuristicCache,
 }
 
 fn bad(option: &'static str, reason: impl Into<String>) -> PlanJobError {
@@ -398,33 +408,57 @@ pub fn prepare(
     foot_model: Option<FootModel>,
 ) -> Result<Prepared, PlanJobError> {
     let t0 = Instant::now();
-    let file = || scenario.path.clone();
     let params = params_for(scenario, k12, step_cost_factor, foot_model)?;
     let (maps, lattice) = build_maps(scenario, robot, &params)?;
-    let mut states = [LatticeState::new(0, 0, 0); 2];
-    for (k, (which, pose)) in
-        [("start", scenario.start), ("goal", scenario.goal)].into_iter().enumerate()
-    {
-        let Some(s) = lattice.state(&pose) else {
-            return Err(PlanJobError::OffMap {
-                scenario: file(),
-                which,
-                pose,
-                bounds: maps.heights().bounds(),
-            });
-        };
-        if let Some(reason) = unfit(robot, &params, &maps, &lattice.pose(s)) {
-            return Err(PlanJobError::Untraversable { scenario: file(), which, pose, reason });
-        }
-        states[k] = s;
-    }
+    let endpoint = |which, pose| endpoint(scenario, robot, &params, (&maps, &lattice), which, pose);
+    let start = endpoint("start", scenario.start)?;
+    let goal = endpoint("goal", scenario.goal)?;
     Ok(Prepared {
+        start,
+        goal,
         params,
         maps,
-        start: states[0],
-        goal: states[1],
+        lattice,
         setup_time_s: t0.elapsed().as_secs_f64(),
+        heuristics: HeuristicCache::default(),
     })
+}
+
+/// [`prepare`] with the overrides of `opts` (as [`run`] prepares).
+///
+/// # Errors
+/// As [`prepare`].
+pub fn prepare_for(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    opts: &PlanOptions,
+) -> Result<Prepared, PlanJobError> {
+    prepare(scenario, robot, opts.k12, opts.step_cost_factor, opts.foot_model)
+}
+
+/// The lattice state of `scenario`'s `which` pose `pose`, checked: on the map, and one
+/// the robot can stand at ([`unfit`]).
+fn endpoint(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    params: &Params,
+    (maps, lattice): (&CostMaps, &Lattice),
+    which: &'static str,
+    pose: Pose2,
+) -> Result<LatticeState, PlanJobError> {
+    let file = || scenario.path.clone();
+    let Some(s) = lattice.state(&pose) else {
+        return Err(PlanJobError::OffMap {
+            scenario: file(),
+            which,
+            pose,
+            bounds: maps.heights().bounds(),
+        });
+    };
+    if let Some(reason) = unfit(robot, params, maps, &lattice.pose(s)) {
+        return Err(PlanJobError::Untraversable { scenario: file(), which, pose, reason });
+    }
+    Ok(s)
 }
 
 /// The scenario's parameters with the options' overrides, validated.
@@ -498,29 +532,24 @@ fn unfit(
     }
 }
 
-/// The pose a replan with `opts` starts from: `scenario.start` if the planner can start there, else
-/// the nearest lattice pose within `radius_m` and two orientation steps that it can (the
-/// nearest first, then the smaller turn), else `scenario.start` (whose planning then
-/// fails with [`PlanJobError::Untraversable`]). A robot that stopped mid-manoeuvre may
-/// stand with a wheel next to an edge, where no plan may start; the path follower takes
-/// it from where it stands to the new path's first pose.
-///
-/// # Errors
-/// Invalid parameters or an unbuildable map.
+/// The pose a replan starts from: `start` if the planner can start there, else the
+/// nearest lattice pose within `radius_m` and two orientation steps of it that it can (the
+/// nearest first, then the smaller turn), else `start` (whose planning then fails with
+/// [`PlanJobError::Untraversable`], [`Prepared::set_start`]). A robot that stopped
+/// mid-manoeuvre may stand with a wheel next to an edge, where no plan may start; the path
+/// follower takes it from where it stands to the new path's first pose.
 pub fn nearest_start(
-    scenario: &Scenario,
+    prep: &Prepared,
     robot: &RobotDescription,
-    opts: &PlanOptions,
+    start: Pose2,
     radius_m: f64,
-) -> Result<Pose2, PlanJobError> {
-    let params = params_for(scenario, opts.k12, opts.step_cost_factor, opts.foot_model)?;
-    let (maps, lattice) = build_maps(scenario, robot, &params)?;
-    let start = scenario.start;
+) -> Pose2 {
+    let (params, maps, lattice) = (&prep.params, &prep.maps, &prep.lattice);
     let Some(s) = lattice.state(&start) else {
-        return Ok(start);
+        return start;
     };
-    if unfit(robot, &params, &maps, &lattice.pose(s)).is_none() {
-        return Ok(start);
+    if unfit(robot, params, maps, &lattice.pose(s)).is_none() {
+        return start;
     }
     let r = (radius_m / lattice.resolution).ceil() as i32;
     let n = i32::from(lattice.orientations);
@@ -549,14 +578,30 @@ pub fn nearest_start(
         }
         let theta = (i32::from(s.theta) + dt).rem_euclid(n) as u8;
         let pose = lattice.pose(LatticeState::new(i, j, theta));
-        if unfit(robot, &params, &maps, &pose).is_none() {
-            return Ok(pose);
+        if unfit(robot, params, maps, &pose).is_none() {
+            return pose;
         }
     }
-    Ok(start)
+    start
 }
 
 impl Prepared {
+    /// Moves the start to `start` (a replan from where the robot stands), checked as
+    /// [`prepare`] checks `scenario`'s.
+    ///
+    /// # Errors
+    /// [`PlanJobError::OffMap`] or [`PlanJobError::Untraversable`] naming `scenario`.
+    pub fn set_start(
+        &mut self,
+        scenario: &Scenario,
+        robot: &RobotDescription,
+        start: Pose2,
+    ) -> Result<(), PlanJobError> {
+        let world = (&self.maps, &self.lattice);
+        self.start = endpoint(scenario, robot, &self.params, world, "start", start)?;
+        Ok(())
+    }
+
     /// The hybrid graph for this scenario with `neighbourhood` and k12 = `k12`.
     ///
     /// # Errors
@@ -673,6 +718,37 @@ pub fn run(
     robot: &RobotDescription,
     opts: &PlanOptions,
 ) -> Result<PlanSummary, PlanJobError> {
+    let limit = check_options(opts)?;
+    let t0 = Instant::now();
+    let prep = prepare_for(scenario, robot, opts)?;
+    search_prepared(&prep, scenario, robot, opts, (t0, limit))
+}
+
+/// Plans on a world [`prepare_for`] built for `scenario` with `opts`' overrides, from its
+/// start ([`Prepared::set_start`]): [`run`] without building the maps again, and with the
+/// heuristic tables of the world's earlier plans toward the same goal.
+///
+/// # Errors
+/// As [`run`]; [`PlanJobError::BadOption`] if `prep` was built with other parameters.
+pub fn run_on(
+    prep: &Prepared,
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    opts: &PlanOptions,
+) -> Result<PlanSummary, PlanJobError> {
+    let limit = check_options(opts)?;
+    let params = params_for(scenario, opts.k12, opts.step_cost_factor, opts.foot_model)?;
+    if params != prep.params {
+        return Err(bad(
+            "prepared",
+            "the world was prepared with other parameters than these options give",
+        ));
+    }
+    search_prepared(prep, scenario, robot, opts, (Instant::now(), limit))
+}
+
+/// The time limit of `opts`, after checking every option.
+fn check_options(opts: &PlanOptions) -> Result<Duration, PlanJobError> {
     let limit = check_time("time_limit_s", opts.time_limit_s)?;
     if let Some(e) = opts.initial_epsilon
         && !(e.is_finite() && e >= 1.0)
@@ -697,12 +773,25 @@ pub fn run(
             format!("{e} must be at least 1 and at most the initial ε"),
         ));
     }
-    let t0 = Instant::now();
+    Ok(limit)
+}
+
+/// The search of [`run`] and [`run_on`] on `prep`, its time limit `limit` counted from
+/// `t0`.
+fn search_prepared(
+    prep: &Prepared,
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    opts: &PlanOptions,
+    (t0, limit): (Instant, Duration),
+) -> Result<PlanSummary, PlanJobError> {
     let file = || scenario.path.clone();
-    let prep = prepare(scenario, robot, opts.k12, opts.step_cost_factor, opts.foot_model)?;
     let neighbourhood = opts.neighbourhood.unwrap_or_else(|| default_neighbourhood(opts.algorithm));
     let lattice_err = |source| PlanJobError::Lattice { scenario: file(), source };
-    let mut graph = prep.graph(robot, neighbourhood, prep.params.k12).map_err(lattice_err)?;
+    let mut graph = prep
+        .graph(robot, neighbourhood, prep.params.k12)
+        .map_err(lattice_err)?
+        .with_heuristic_cache(&prep.heuristics);
     graph.forbid(&opts.forbidden);
     // The heuristic's tables are built before the search's clock starts (within the
     // plan's time limit, which counts from `t0`).
@@ -784,6 +873,7 @@ pub fn run(
             setup_time_s: heuristic_setup.as_secs_f64(),
             cost_to_go_nodes: graph.cost_to_go_nodes(),
             cost_to_go_frozen: graph.heuristic_frozen(),
+            reused: graph.heuristic_reused(),
         },
         footprints: graph.footprint_count(),
         step_cost_factor: prep.params.step_cost_factor,

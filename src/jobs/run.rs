@@ -15,7 +15,7 @@
 //! decide the verdict.
 
 use super::detailed::DetailedJobError;
-use super::plan::{self, PlanJobError, PlanOptions, PlanSummary};
+use super::plan::{self, PlanJobError, PlanOptions, PlanSummary, Prepared};
 use super::sim::{CONTROL_HZ, SETTLE_S};
 use crate::control::path_follower::FollowerConfig;
 use crate::control::step_executor::{
@@ -54,9 +54,6 @@ pub enum RunJobError {
     /// The height map could not be built.
     #[error(transparent)]
     Costmap(#[from] super::costmap::CostmapError),
-    /// The cost layers for the recording could not be built.
-    #[error(transparent)]
-    Cost(#[from] crate::cost::CostError),
     /// The robot stands where the height map knows no ground.
     #[error("no ground height known under a foot at ({x:.3}, {y:.3})")]
     UnknownGround {
@@ -454,17 +451,19 @@ pub struct Mission {
     pub detailed: DetailedPath,
 }
 
-/// Plans `scenario` from its start and expands the path with `sim`'s CoM model.
+/// Plans `scenario` on the world `prep` (`plan::prepare_for` with `opts`) from its start
+/// and expands the path with `sim`'s CoM model.
 ///
 /// # Errors
 /// Planning or the expansion failed.
 pub fn plan_mission(
+    prep: &Prepared,
     scenario: &Scenario,
     sim: &mut Simulation,
     opts: &PlanOptions,
 ) -> Result<Mission, RunJobError> {
     let robot = sim.robot().clone();
-    let mut plan = plan::run(scenario, &robot, opts)?;
+    let mut plan = plan::run_on(prep, scenario, &robot, opts)?;
     let mut planning_time_s = plan.planning_time_s;
     // The planner and the generator share one feasibility model, but the generator
     // checks every centimetre of a manoeuvre the planner checks at its stances: what it
@@ -477,7 +476,9 @@ pub fn plan_mission(
     };
     let mut first: Option<RunJobError> = None;
     loop {
-        let (name, source) = match expand_mission(scenario, sim, &plan, plan.path.len()) {
+        let expanded =
+            super::detailed::expand_prefix_on(prep, scenario, sim, &plan, plan.path.len());
+        let (name, source) = match expanded.map_err(RunJobError::from) {
             Ok(detailed) => {
                 plan.planning_time_s = planning_time_s;
                 return Ok(Mission { plan, detailed });
@@ -495,7 +496,7 @@ pub fn plan_mission(
             return Err(original);
         };
         retry.forbidden.push(e);
-        match plan::run(scenario, &robot, &retry) {
+        match plan::run_on(prep, scenario, &robot, &retry) {
             Ok(p) => {
                 planning_time_s += p.planning_time_s;
                 plan = p;
@@ -525,10 +526,18 @@ pub fn expand_mission(
     plan: &PlanSummary,
     end: usize,
 ) -> Result<DetailedPath, RunJobError> {
-    super::detailed::expand_prefix(scenario, sim, plan, end).map_err(|e| match e {
-        DetailedJobError::Plan(e) => RunJobError::Plan(e),
-        DetailedJobError::Motion { scenario, source } => RunJobError::Motion { scenario, source },
-    })
+    Ok(super::detailed::expand_prefix(scenario, sim, plan, end)?)
+}
+
+impl From<DetailedJobError> for RunJobError {
+    fn from(e: DetailedJobError) -> Self {
+        match e {
+            DetailedJobError::Plan(e) => RunJobError::Plan(e),
+            DetailedJobError::Motion { scenario, source } => {
+                RunJobError::Motion { scenario, source }
+            }
+        }
+    }
 }
 
 /// Plans, expands and executes `scenario` in closed loop.
@@ -538,12 +547,15 @@ pub fn expand_mission(
 pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobError> {
     let wall = Instant::now();
     let mut sim = Simulation::new(scenario, &opts.model_path)?;
-    let mission = match plan_mission(scenario, &mut sim, &opts.plan) {
+    // One world for the run: every plan (retries, replans), the generator and the
+    // recording use its maps, and the plans share its heuristic toward the goal.
+    let mut prep = plan::prepare_for(scenario, sim.robot(), &opts.plan)?;
+    let mission = match plan_mission(&prep, scenario, &mut sim, &opts.plan) {
         Ok(m) => m,
         Err(e) => return unexecuted(scenario, e, wall),
     };
     super::stand_at_start(&mut sim, scenario)?;
-    execute(scenario, &mut sim, mission, opts, wall)
+    execute(scenario, &mut prep, &mut sim, mission, opts, wall)
 }
 
 /// The summary of a run that never started executing because planning ended without a
@@ -633,7 +645,9 @@ fn log_mission(r: &Recorder, m: &Mission) -> Result<(), VizError> {
 }
 
 /// Executes `mission` in `sim` from its current state (the robot standing at the plan's
-/// start), replanning when the executor leaves the plan; `wall` is when the job started.
+/// start), replanning on the world `prep` (`plan::prepare_for` with `opts.plan`, which the
+/// mission was planned on) when the executor leaves the plan; `wall` is when the job
+/// started.
 ///
 /// # Errors
 /// [`RunJobError`] if the maps cannot be built, the simulation diverges or the recording
@@ -641,6 +655,7 @@ fn log_mission(r: &Recorder, m: &Mission) -> Result<(), VizError> {
 #[allow(clippy::too_many_lines)]
 pub fn execute(
     scenario: &Scenario,
+    prep: &mut Prepared,
     sim: &mut Simulation,
     mission: Mission,
     opts: &RunOptions,
@@ -665,11 +680,11 @@ pub fn execute(
             let mut r = Recorder::create(path, "momaro run")?;
             r.log_world(&sim.geom_shapes(), &sim.body_poses())?;
             r.log_height_map(&heights)?;
-            let maps = crate::cost::CostMaps::build(&heights, &robot, params)?;
-            let (nx, ny) = heights.dims();
+            let (maps, planned) = (&prep.maps, prep.maps.heights());
+            let (nx, ny) = planned.dims();
             let foot: Vec<_> = (0..nx * ny).map(|k| maps.foot_cost_cell(k % nx, k / nx)).collect();
             if let Some(img) = crate::cost_image::cost_layer_image(&foot, nx, ny, None) {
-                r.log_layer_image("foot_cost", &img, heights.origin(), heights.resolution())?;
+                r.log_layer_image("foot_cost", &img, planned.origin(), planned.resolution())?;
             }
             log_mission(&r, &mission)?;
             Some(r)
@@ -732,16 +747,13 @@ pub fn execute(
                 replans += 1;
                 let t = Instant::now();
                 let mut from_here = scenario.clone();
-                from_here.start = truth;
+                from_here.start = plan::nearest_start(prep, &robot, truth, REPLAN_START_RADIUS_M);
                 let replan_opts =
                     PlanOptions { time_limit_s: opts.replan_time_limit_s, ..opts.plan.clone() };
-                let result =
-                    plan::nearest_start(&from_here, &robot, &replan_opts, REPLAN_START_RADIUS_M)
-                        .map_err(RunJobError::from)
-                        .and_then(|start| {
-                            from_here.start = start;
-                            plan_mission(&from_here, sim, &replan_opts)
-                        });
+                let result = prep
+                    .set_start(&from_here, &robot, from_here.start)
+                    .map_err(RunJobError::from)
+                    .and_then(|()| plan_mission(prep, &from_here, sim, &replan_opts));
                 replan_wall += t.elapsed().as_secs_f64();
                 match result {
                     Ok(m) => {

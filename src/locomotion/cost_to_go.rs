@@ -259,6 +259,13 @@ impl CostToGo {
         self.deadline.set(deadline);
     }
 
+    /// Lets a search the deadline stopped grow again (its queue is kept): for a new
+    /// search on the same tables, whose queries then get `D` itself until its own
+    /// deadline. Never within one search: a node's bound must not change under it.
+    pub fn thaw(&self) {
+        self.search.borrow_mut().frozen = None;
+    }
+
     /// Whether the deadline stopped the search (see [`CostToGo::set_deadline`]).
     pub fn frozen(&self) -> bool {
         self.search.borrow().frozen.is_some()

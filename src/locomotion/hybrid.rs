@@ -177,8 +177,9 @@ use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
 use crate::stability::stability_margin;
 use serde::Serialize;
-use std::cell::{Cell, OnceCell};
+use std::cell::{Cell, OnceCell, RefCell};
 use std::collections::HashMap;
+use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 /// What an edge of the hybrid graph does.
@@ -426,6 +427,35 @@ struct HeuristicTables {
     setup: Duration,
 }
 
+/// The heuristic tables of the graphs on one cost map, by what they were built for:
+/// a later graph of the same robot, configuration and goal on the same map takes them
+/// over ([`HybridGraph::with_heuristic_cache`]) instead of building them again, and its
+/// searches resume the cost-to-go where the earlier ones left it. A job keeps one per
+/// map (`jobs::plan::Prepared`), so a plan's retries with edges the motion generator
+/// rejected, and the replans of a run, share one heuristic. Forbidden edges
+/// ([`HybridGraph::forbid`]) do not enter the tables, which are relaxations: a lower
+/// bound, and consistent, stays so when edges are taken away.
+#[derive(Default)]
+pub struct HeuristicCache {
+    entries: RefCell<Vec<CachedTables>>,
+}
+
+impl std::fmt::Debug for HeuristicCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("HeuristicCache").field("tables", &self.entries.borrow().len()).finish()
+    }
+}
+
+/// One entry of a [`HeuristicCache`]: tables and what they were built for.
+struct CachedTables {
+    /// The cost map's address (a cache serves one map).
+    maps: usize,
+    robot: RobotDescription,
+    config: HybridConfig,
+    goal: DrivingGoal,
+    tables: Rc<HeuristicTables>,
+}
+
 /// The hybrid graph over one cost map.
 pub struct HybridGraph<'c> {
     maps: &'c CostMaps,
@@ -454,9 +484,14 @@ pub struct HybridGraph<'c> {
     /// Scratch buffer for the labelled special successors.
     special: Vec<(LatticeState, Cost, Manoeuvre)>,
     stats: ManoeuvreStats,
-    /// The heuristic's tables, built at its first use: a graph asked only for edges
-    /// (`jobs::plan`'s plain-cost graph) never builds them.
-    heuristic: OnceCell<HeuristicTables>,
+    /// The heuristic's tables, built (or taken from `heuristic_cache`) at its first
+    /// use: a graph asked only for edges (`jobs::plan`'s plain-cost graph) never builds
+    /// them.
+    heuristic: OnceCell<Rc<HeuristicTables>>,
+    /// Where earlier graphs on this map left their tables, if given.
+    heuristic_cache: Option<&'c HeuristicCache>,
+    /// Whether the tables came from `heuristic_cache`.
+    heuristic_reused: Cell<bool>,
     /// The cost-to-go's deadline, for tables built after it was set.
     heuristic_deadline: Cell<Option<Instant>>,
     /// [`Self::target_ok`] of non-neutral footprints by (cell, orientation, offsets): a
@@ -632,6 +667,8 @@ impl<'c> HybridGraph<'c> {
             special: Vec::with_capacity(16),
             stats: ManoeuvreStats::default(),
             heuristic: OnceCell::new(),
+            heuristic_cache: None,
+            heuristic_reused: Cell::new(false),
             heuristic_deadline: Cell::new(None),
             standable: HashMap::default(),
             wheel_move_checks: HashMap::default(),
@@ -640,44 +677,78 @@ impl<'c> HybridGraph<'c> {
         })
     }
 
-    /// The heuristic's tables, built on the first call.
+    /// This graph with the heuristic tables of `cache` (see [`HeuristicCache`]): taken
+    /// over if an earlier graph on the same map built them for the same robot,
+    /// configuration and goal, else built at the first query and left there.
+    #[must_use]
+    pub fn with_heuristic_cache(mut self, cache: &'c HeuristicCache) -> Self {
+        self.heuristic_cache = Some(cache);
+        self
+    }
+
+    /// The heuristic's tables, built (or taken from the cache) on the first call.
     fn tables(&self) -> &HeuristicTables {
         self.heuristic.get_or_init(|| {
-            let t0 = Instant::now();
-            let res = self.lattice.resolution;
-            let max_step_cells = self.reach.iter().map(|r| i32::from(r[1]) - i32::from(r[0])).max();
-            let max_step_length_m = f64::from(max_step_cells.unwrap_or(0).max(0)) * res;
-            let (config, goal) = (&self.config, self.driving.goal());
-            let step_bound = build_step_bound(
-                self.maps,
-                &self.near,
-                config,
-                &self.lattice,
-                goal,
-                max_step_length_m,
-            );
-            // A base shift costs at least f · k10 per metre (C_B ≥ 1) and raises the
-            // foot-offset potential by 4 c per cell (`heuristic::offset_potential`).
-            let shift_step =
-                Cost::from_f64_floor(config.step_cost_factor * config.k10 * res * (1.0 - 1e-9))
-                    .saturating_add(Cost(step_bound.offset_per_cell().0.saturating_mul(4)));
-            let cost_to_go = CostToGo::new(
-                self.lattice,
-                &config.driving,
-                shift_step,
-                (goal.i, goal.j, goal.theta),
-                (config.cost_to_go_groups, config.max_oriented_nodes),
-            );
-            cost_to_go.set_deadline(self.heuristic_deadline.get());
-            let regions = BaseRegions::build(
-                self.maps,
-                &self.robot,
-                &self.lattice,
-                config.motion.base_circle_radius_m,
-                (goal.i, goal.j),
-            );
-            HeuristicTables { regions, step_bound, cost_to_go, setup: t0.elapsed() }
+            let goal = self.driving.goal();
+            let maps = std::ptr::from_ref(self.maps) as usize;
+            let fits = |e: &CachedTables| {
+                e.maps == maps && e.goal == goal && e.config == self.config && e.robot == self.robot
+            };
+            let cached = self.heuristic_cache.and_then(|cache| {
+                cache.entries.borrow().iter().find(|e| fits(e)).map(|e| Rc::clone(&e.tables))
+            });
+            if let Some(tables) = cached {
+                // A new search's budget: the cost-to-go grows again from where the
+                // earlier searches left it.
+                tables.cost_to_go.thaw();
+                tables.cost_to_go.set_deadline(self.heuristic_deadline.get());
+                self.heuristic_reused.set(true);
+                return tables;
+            }
+            let tables = Rc::new(self.build_tables());
+            if let Some(cache) = self.heuristic_cache {
+                cache.entries.borrow_mut().push(CachedTables {
+                    maps,
+                    robot: self.robot.clone(),
+                    config: self.config,
+                    goal,
+                    tables: Rc::clone(&tables),
+                });
+            }
+            tables
         })
+    }
+
+    /// Builds the heuristic's tables for this graph's map, configuration and goal.
+    fn build_tables(&self) -> HeuristicTables {
+        let t0 = Instant::now();
+        let res = self.lattice.resolution;
+        let max_step_cells = self.reach.iter().map(|r| i32::from(r[1]) - i32::from(r[0])).max();
+        let max_step_length_m = f64::from(max_step_cells.unwrap_or(0).max(0)) * res;
+        let (config, goal) = (&self.config, self.driving.goal());
+        let step_bound =
+            build_step_bound(self.maps, &self.near, config, &self.lattice, goal, max_step_length_m);
+        // A base shift costs at least f · k10 per metre (C_B ≥ 1) and raises the
+        // foot-offset potential by 4 c per cell (`heuristic::offset_potential`).
+        let shift_step =
+            Cost::from_f64_floor(config.step_cost_factor * config.k10 * res * (1.0 - 1e-9))
+                .saturating_add(Cost(step_bound.offset_per_cell().0.saturating_mul(4)));
+        let cost_to_go = CostToGo::new(
+            self.lattice,
+            &config.driving,
+            shift_step,
+            (goal.i, goal.j, goal.theta),
+            (config.cost_to_go_groups, config.max_oriented_nodes),
+        );
+        cost_to_go.set_deadline(self.heuristic_deadline.get());
+        let regions = BaseRegions::build(
+            self.maps,
+            &self.robot,
+            &self.lattice,
+            config.motion.base_circle_radius_m,
+            (goal.i, goal.j),
+        );
+        HeuristicTables { regions, step_bound, cost_to_go, setup: t0.elapsed() }
     }
 
     /// Whether the heuristic's tables have been built (by a first heuristic query).
@@ -687,9 +758,18 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// Time spent building the heuristic's step bound and reachable regions (not part of
-    /// any search's time: `jobs::plan` has them built before it starts the clock).
+    /// any search's time: `jobs::plan` has them built before it starts the clock); zero
+    /// when they came from a [`HeuristicCache`].
     pub fn heuristic_setup_time(&self) -> Duration {
-        self.tables().setup
+        let setup = self.tables().setup;
+        if self.heuristic_reused.get() { Duration::ZERO } else { setup }
+    }
+
+    /// Whether the heuristic's tables came from a [`HeuristicCache`] (an earlier graph
+    /// built them); builds or fetches them if no query has yet.
+    pub fn heuristic_reused(&self) -> bool {
+        self.tables();
+        self.heuristic_reused.get()
     }
 
     /// The parts of the heuristic of `s` (see [`HeuristicParts`]).
@@ -776,7 +856,8 @@ impl<'c> HybridGraph<'c> {
         self.heuristic.get().is_some_and(|t| t.cost_to_go.frozen())
     }
 
-    /// (Cell, orientation) nodes the heuristic's cost-to-go has settled so far.
+    /// (Cell, orientation) nodes the heuristic's cost-to-go has settled so far (with
+    /// those of the earlier searches, when the tables came from a [`HeuristicCache`]).
     pub fn cost_to_go_nodes(&self) -> usize {
         self.heuristic.get().map_or(0, |t| t.cost_to_go.settled())
     }

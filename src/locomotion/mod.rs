@@ -38,8 +38,8 @@ pub use driving::{
 };
 pub use footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 pub use hybrid::{
-    HeuristicParts, HybridConfig, HybridGraph, Manoeuvre, ManoeuvreKind, ManoeuvreStats, PoseKey,
-    StepCost, base_shift_cost, foot_move_cost, step_cost,
+    HeuristicCache, HeuristicParts, HybridConfig, HybridGraph, Manoeuvre, ManoeuvreKind,
+    ManoeuvreStats, PoseKey, StepCost, base_shift_cost, foot_move_cost, step_cost,
 };
 pub use lattice::{Lattice, LatticeError, LatticeState, Move, NEUTRAL_FOOTPRINT, Neighbourhood};
 pub use orientation::OrientationFactor;

@@ -302,6 +302,61 @@ mod hybrid {
     }
 
     #[test]
+    fn graphs_sharing_a_heuristic_cache_build_the_tables_once() {
+        let maps = platform_maps(0.2);
+        let goal = state_on(&maps, 2.0, 0.0, 0.0);
+        let cache = HeuristicCache::default();
+        let first = graph(&maps, goal).with_heuristic_cache(&cache);
+        let s = state_at(&first, -0.5, 0.0);
+        let h = first.heuristic(s);
+        assert!(!first.heuristic_reused());
+        assert!(first.heuristic_setup_time() > std::time::Duration::ZERO);
+        let nodes = first.cost_to_go_nodes();
+        assert!(nodes > 0);
+        // Same map, robot, configuration and goal: taken over, with the nodes settled.
+        let second = graph(&maps, goal).with_heuristic_cache(&cache);
+        assert!(second.heuristic_reused());
+        assert_eq!(second.heuristic_setup_time(), std::time::Duration::ZERO);
+        assert_eq!(second.cost_to_go_nodes(), nodes);
+        assert_eq!(second.heuristic(s), h);
+        // The same values as tables of its own, also where the first never asked.
+        let fresh = graph(&maps, goal);
+        for (x, y) in [(-0.9, -0.8), (0.3, 0.7), (1.5, 0.0), (2.9, 0.9)] {
+            let t = state_at(&fresh, x, y);
+            assert_eq!(second.heuristic(t), fresh.heuristic(t), "at ({x}, {y})");
+        }
+        // Another goal, configuration or map: tables of its own.
+        let elsewhere = graph(&maps, state_on(&maps, 2.5, 0.5, 0.0)).with_heuristic_cache(&cache);
+        assert!(!elsewhere.heuristic_reused());
+        let plain = Params { k12: 1.0, ..Params::default() };
+        let cfg = HybridConfig::new(&plain, &robot(), Neighbourhood::N16);
+        let priced = HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal))
+            .expect("graph")
+            .with_heuristic_cache(&cache);
+        assert!(!priced.heuristic_reused());
+        let copy = platform_maps(0.2);
+        assert!(!graph(&copy, goal).with_heuristic_cache(&cache).heuristic_reused());
+    }
+
+    #[test]
+    fn a_later_search_thaws_the_cost_to_go_an_earlier_deadline_froze() {
+        let maps = platform_maps(0.2);
+        let goal = state_on(&maps, 2.0, 0.0, 0.0);
+        let cache = HeuristicCache::default();
+        let first = graph(&maps, goal).with_heuristic_cache(&cache);
+        // A deadline already past: the first query freezes the cost-to-go at once.
+        first.set_heuristic_deadline(Some(std::time::Instant::now()));
+        let s = state_at(&first, -0.5, 0.0);
+        let frozen = first.heuristic(s);
+        assert!(first.heuristic_frozen());
+        let second = graph(&maps, goal).with_heuristic_cache(&cache);
+        let fresh = graph(&maps, goal);
+        assert_eq!(second.heuristic(s), fresh.heuristic(s));
+        assert!(!second.heuristic_frozen());
+        assert!(second.heuristic(s) > frozen, "{:?} {frozen:?}", second.heuristic(s));
+    }
+
+    #[test]
     fn manoeuvre_costs_by_hand() {
         let c = config();
         // eq. 5: 0.5 · 0.45 + 0.1 · (3 − 1) + 2.3 · 0.2 = 0.225 + 0.2 + 0.46.
