@@ -1029,12 +1029,12 @@ impl<'c> HybridGraph<'c> {
         let pose = self.lattice.pose(s);
         let world = Self::feet_xyz(feet);
         let rule = &self.config.motion.standing;
-        let (p, _, legs) = rule
-            .stand_legs(&self.robot, self.maps.leg_terrain(), world, [pose.x, pose.y], pose.theta)
+        let (terrain, swept) = (self.maps.leg_terrain(), self.maps.swept_leg_terrain());
+        let (p, _, _, swept) = rule
+            .stand_legs_clear_of(&self.robot, terrain, swept, world, [pose.x, pose.y], pose.theta)
             .ok()?;
         self.feasibility.body_clear(&p, self.maps).ok()?;
         let hips = hips_in_world(&self.robot, &p);
-        let swept = rule.legs_clear(&self.robot, self.maps.swept_leg_terrain(), &legs).is_ok();
         Some((std::array::from_fn(|k| hips[k][2] - world[k][2]), swept))
     }
 

@@ -197,21 +197,39 @@ impl StandingRule {
         xy: [f64; 2],
         yaw: f64,
     ) -> Result<(Posture, f64), PostureError> {
-        self.stand_legs(robot, terrain, feet, xy, yaw).map(|(p, h, _)| (p, h))
+        self.stand_legs_within(robot, (terrain, None), feet, xy, yaw).map(|(p, h, _, _)| (p, h))
     }
 
-    /// [`Self::stand`] with the posture's solved legs.
+    /// [`Self::stand`] on `terrain` with the posture's solved legs, and whether the posture's legs also clear
+    /// `wider` ([`Self::legs_clear`]): heights at least `terrain`'s wherever `terrain`
+    /// knows one (a wider dilation of the same map, as `CostMaps::swept_leg_terrain` is
+    /// of `CostMaps::leg_terrain`). `wider` is checked first at each height: legs clear
+    /// of it are clear of `terrain` at the same points, so the common case costs one
+    /// clearance check instead of two, and the answer is the same.
     ///
     /// # Errors
     /// As [`Self::stand`].
-    pub fn stand_legs(
+    pub fn stand_legs_clear_of(
         &self,
         robot: &RobotDescription,
         terrain: &HeightMap,
+        wider: &HeightMap,
         feet: [[f64; 3]; 4],
         xy: [f64; 2],
         yaw: f64,
-    ) -> Result<(Posture, f64, SolvedLegs), PostureError> {
+    ) -> Result<(Posture, f64, SolvedLegs, bool), PostureError> {
+        self.stand_legs_within(robot, (terrain, Some(wider)), feet, xy, yaw)
+    }
+
+    /// [`Self::stand_legs_clear_of`], `wider` optional (none: `false`).
+    fn stand_legs_within(
+        &self,
+        robot: &RobotDescription,
+        (terrain, wider): (&HeightMap, Option<&HeightMap>),
+        feet: [[f64; 3]; 4],
+        xy: [f64; 2],
+        yaw: f64,
+    ) -> Result<(Posture, f64, SolvedLegs, bool), PostureError> {
         let pitch = self.pitch(&feet, yaw);
         let ground = feet.map(|f| f[2]);
         let frame = BaseFrame::new([0.0, pitch, yaw]);
@@ -223,10 +241,18 @@ impl StandingRule {
                 continue;
             }
             let p = level_posture_in(robot, feet, [true; 4], xy, &frame, h, ground);
-            match solve_chains_in(robot, &frame, &p, self.reach_margin_m)
-                .and_then(|legs| self.legs_clear(robot, terrain, &legs).map(|()| legs))
-            {
-                Ok(legs) => return Ok((p, h, legs)),
+            let legs = match solve_chains_in(robot, &frame, &p, self.reach_margin_m) {
+                Ok(legs) => legs,
+                Err(e) => {
+                    last = Some(e);
+                    continue;
+                }
+            };
+            if wider.is_some_and(|w| self.legs_clear(robot, w, &legs).is_ok()) {
+                return Ok((p, h, legs, true));
+            }
+            match self.legs_clear(robot, terrain, &legs) {
+                Ok(()) => return Ok((p, h, legs, false)),
                 Err(e) => last = Some(e),
             }
         }
@@ -898,6 +924,58 @@ mod tests {
         let front = 0.35 * -(0.1f64.sin()) - 0.05 * 0.1f64.cos();
         assert!((z - (0.45 - front)).abs() < 1e-12, "{z}");
         assert_eq!(z, base_z(&robot, &[0.0; 4], rpy, 0.45));
+    }
+
+    #[test]
+    fn standing_clear_of_wider_terrain_is_standing_then_checking_it() {
+        // Blocks of 0.05–0.3 m on a 2.5 cm grid; feet on the ground under a neutral
+        // footprint stretched by up to ±0.15 m, over a grid of poses and yaws: the
+        // posture, height and verdict are those of `stand` followed by `legs_clear` on the
+        // wider terrain, errors included.
+        let robot = RobotDescription::reference();
+        let r = rule();
+        let heights = HeightMap::from_fn([-1.5, -1.5], 0.025, 120, 120, |i, j| {
+            let (bi, bj) = (i / 10, j / 10);
+            match (bi * 7 + bj * 13) % 5 {
+                0 => 0.05 * ((bi + bj) % 6) as f64,
+                _ => 0.0,
+            }
+        })
+        .unwrap();
+        let plain = heights.dilated_max(crate::cost::LEG_TERRAIN_CELLS);
+        let wider =
+            heights.dilated_max(crate::cost::LEG_TERRAIN_CELLS + crate::feasibility::SWEEP_CELLS);
+        let neutral = robot.neutral_footprint();
+        let mut seen = [0usize; 3];
+        for n in 0..600 {
+            let (x, y) = (-0.5 + 0.1 * (n % 11) as f64, -0.5 + 0.1 * ((n / 11) % 11) as f64);
+            let yaw = 0.7 * (n % 9) as f64;
+            let stretch = 0.05 * ((n % 7) as f64 - 3.0);
+            let (sn, cs) = yaw.sin_cos();
+            let feet: [[f64; 3]; 4] = std::array::from_fn(|k| {
+                let (fx, fy) = (neutral[k][0] + if k < 2 { stretch } else { 0.0 }, neutral[k][1]);
+                let (wx, wy) = (x + cs * fx - sn * fy, y + sn * fx + cs * fy);
+                [wx, wy, heights.height_at_cell(wx, wy).unwrap()]
+            });
+            let both = r.stand_legs_clear_of(&robot, &plain, &wider, feet, [x, y], yaw);
+            let apart = r.stand(&robot, &plain, feet, [x, y], yaw).map(|(p, h)| {
+                let legs = solve_chains(&robot, &p, r.reach_margin_m).unwrap();
+                (p, h, r.legs_clear(&robot, &wider, &legs).is_ok())
+            });
+            match (both, apart) {
+                (Ok((p, h, _, clear)), Ok((q, g, also))) => {
+                    assert_eq!((p, h, clear), (q, g, also), "case {n}");
+                    seen[usize::from(clear)] += 1;
+                }
+                (Err(e), Err(f)) => {
+                    assert_eq!(e, f, "case {n}");
+                    seen[2] += 1;
+                }
+                (a, b) => panic!("case {n}: {a:?} against {b:?}"),
+            }
+        }
+        // Every branch was taken.
+        assert!(seen.iter().all(|&c| c > 0), "{seen:?}");
     }
 
     #[test]
