@@ -977,11 +977,12 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                     opts.repeats
                 );
                 say!(
-                    "{:<13} {:<5} {:>10} {:>12} {:>10} {:>7} {:>10} {:>10} {:>12} {:>10} {:>10}",
+                    "{:<13} {:<5} {:>10} {:>12} {:>10} {:>10} {:>7} {:>10} {:>10} {:>12} {:>10} {:>10}",
                     "algo",
                     "nbhd",
                     "optimum",
                     "first",
+                    "warm first",
                     "over opt",
                     "bound",
                     "cost@1s",
@@ -992,11 +993,12 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 );
                 for r in &report.rows {
                     say!(
-                        "{:<13} {:<5} {:>10} {:>12} {:>10} {:>7} {:>10} {:>10} {:>12} {:>10} {:>10}",
+                        "{:<13} {:<5} {:>10} {:>12} {:>10} {:>10} {:>7} {:>10} {:>10} {:>12} {:>10} {:>10}",
                         r.algorithm,
                         r.neighbourhood,
                         c(r.optimum),
                         ms(r.first_solution_s),
+                        ms(r.first_solution_warm_s),
                         pct(r.first_over_optimum_pct),
                         r.first_bound.map_or("-".to_owned(), |b| format!("{b:.2}")),
                         c(r.cost_at_1s),

@@ -310,6 +310,26 @@ fn plans_on_one_prepared_world_share_its_heuristic_and_find_the_same_path() {
     ));
 }
 
+/// `bench plan` times the probe's first path twice: cold, and again on the tables the
+/// cold run left (what a replan finds).
+#[test]
+fn bench_times_the_first_path_cold_and_on_warm_tables() {
+    let s = scenario("flat");
+    let opts = plan::BenchOptions {
+        arastar_time_limit_s: 1.0,
+        optimum_time_limit_s: 60.0,
+        k12: None,
+        repeats: 1,
+    };
+    let report = plan::bench(&s, &robot(), &opts).expect("bench");
+    let probe = report.rows.iter().find(|r| r.algorithm == "arastar+probe").expect("probe row");
+    assert!(probe.first_solution_s.is_some());
+    assert!(probe.first_solution_warm_s.is_some());
+    for r in report.rows.iter().filter(|r| r.algorithm != "arastar+probe") {
+        assert_eq!(r.first_solution_warm_s, None, "{}", r.algorithm);
+    }
+}
+
 #[test]
 fn a_replan_starts_from_the_nearest_pose_a_plan_can_start_from() {
     let base = std::fs::read_to_string(scenario_path("flat")).expect("read");
