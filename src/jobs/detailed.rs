@@ -71,10 +71,9 @@ pub fn expand_prefix(
     plan: &PlanSummary,
     end: usize,
 ) -> Result<DetailedPath, DetailedJobError> {
-    let robot = sim.robot().clone();
     let prep = plan::prepare(
         scenario,
-        &robot,
+        sim.robot(),
         Some(plan.k12),
         Some(plan.step_cost_factor),
         Some(plan.foot_model),

@@ -485,13 +485,11 @@ pub struct HybridGraph<'c> {
     special: Vec<(LatticeState, Cost, Manoeuvre)>,
     stats: ManoeuvreStats,
     /// The heuristic's tables, built (or taken from `heuristic_cache`) at its first
-    /// use: a graph asked only for edges (`jobs::plan`'s plain-cost graph) never builds
-    /// them.
-    heuristic: OnceCell<Rc<HeuristicTables>>,
+    /// use, and whether they were taken: a graph asked only for edges (`jobs::plan`'s
+    /// plain-cost graph) never builds them.
+    heuristic: OnceCell<(Rc<HeuristicTables>, bool)>,
     /// Where earlier graphs on this map left their tables, if given.
     heuristic_cache: Option<&'c HeuristicCache>,
-    /// Whether the tables came from `heuristic_cache`.
-    heuristic_reused: Cell<bool>,
     /// The cost-to-go's deadline, for tables built after it was set.
     heuristic_deadline: Cell<Option<Instant>>,
     /// [`Self::target_ok`] of non-neutral footprints by (cell, orientation, offsets): a
@@ -668,7 +666,6 @@ impl<'c> HybridGraph<'c> {
             stats: ManoeuvreStats::default(),
             heuristic: OnceCell::new(),
             heuristic_cache: None,
-            heuristic_reused: Cell::new(false),
             heuristic_deadline: Cell::new(None),
             standable: HashMap::default(),
             wheel_move_checks: HashMap::default(),
@@ -688,6 +685,11 @@ impl<'c> HybridGraph<'c> {
 
     /// The heuristic's tables, built (or taken from the cache) on the first call.
     fn tables(&self) -> &HeuristicTables {
+        &self.tables_and_origin().0
+    }
+
+    /// The heuristic's tables and whether they came from the cache.
+    fn tables_and_origin(&self) -> &(Rc<HeuristicTables>, bool) {
         self.heuristic.get_or_init(|| {
             let goal = self.driving.goal();
             let maps = std::ptr::from_ref(self.maps) as usize;
@@ -697,25 +699,25 @@ impl<'c> HybridGraph<'c> {
             let cached = self.heuristic_cache.and_then(|cache| {
                 cache.entries.borrow().iter().find(|e| fits(e)).map(|e| Rc::clone(&e.tables))
             });
-            if let Some(tables) = cached {
-                // A new search's budget: the cost-to-go grows again from where the
-                // earlier searches left it.
-                tables.cost_to_go.thaw();
-                tables.cost_to_go.set_deadline(self.heuristic_deadline.get());
-                self.heuristic_reused.set(true);
-                return tables;
-            }
-            let tables = Rc::new(self.build_tables());
-            if let Some(cache) = self.heuristic_cache {
-                cache.entries.borrow_mut().push(CachedTables {
-                    maps,
-                    robot: self.robot.clone(),
-                    config: self.config,
-                    goal,
-                    tables: Rc::clone(&tables),
-                });
-            }
-            tables
+            let reused = cached.is_some();
+            let tables = cached.unwrap_or_else(|| {
+                let tables = Rc::new(self.build_tables());
+                if let Some(cache) = self.heuristic_cache {
+                    cache.entries.borrow_mut().push(CachedTables {
+                        maps,
+                        robot: self.robot.clone(),
+                        config: self.config,
+                        goal,
+                        tables: Rc::clone(&tables),
+                    });
+                }
+                tables
+            });
+            // A new search's budget: taken tables grow again from where the earlier
+            // searches left them.
+            tables.cost_to_go.thaw();
+            tables.cost_to_go.set_deadline(self.heuristic_deadline.get());
+            (tables, reused)
         })
     }
 
@@ -740,7 +742,6 @@ impl<'c> HybridGraph<'c> {
             (goal.i, goal.j, goal.theta),
             (config.cost_to_go_groups, config.max_oriented_nodes),
         );
-        cost_to_go.set_deadline(self.heuristic_deadline.get());
         let regions = BaseRegions::build(
             self.maps,
             &self.robot,
@@ -761,15 +762,14 @@ impl<'c> HybridGraph<'c> {
     /// any search's time: `jobs::plan` has them built before it starts the clock); zero
     /// when they came from a [`HeuristicCache`].
     pub fn heuristic_setup_time(&self) -> Duration {
-        let setup = self.tables().setup;
-        if self.heuristic_reused.get() { Duration::ZERO } else { setup }
+        let (tables, reused) = self.tables_and_origin();
+        if *reused { Duration::ZERO } else { tables.setup }
     }
 
     /// Whether the heuristic's tables came from a [`HeuristicCache`] (an earlier graph
     /// built them); builds or fetches them if no query has yet.
     pub fn heuristic_reused(&self) -> bool {
-        self.tables();
-        self.heuristic_reused.get()
+        self.tables_and_origin().1
     }
 
     /// The parts of the heuristic of `s` (see [`HeuristicParts`]).
@@ -845,7 +845,7 @@ impl<'c> HybridGraph<'c> {
     /// limit): see `CostToGo::set_deadline`.
     pub fn set_heuristic_deadline(&self, deadline: Option<Instant>) {
         self.heuristic_deadline.set(deadline);
-        if let Some(tables) = self.heuristic.get() {
+        if let Some((tables, _)) = self.heuristic.get() {
             tables.cost_to_go.set_deadline(deadline);
         }
     }
@@ -853,13 +853,13 @@ impl<'c> HybridGraph<'c> {
     /// Whether the plan's time limit stopped the heuristic's cost-to-go (see
     /// `CostToGo::set_deadline`).
     pub fn heuristic_frozen(&self) -> bool {
-        self.heuristic.get().is_some_and(|t| t.cost_to_go.frozen())
+        self.heuristic.get().is_some_and(|(t, _)| t.cost_to_go.frozen())
     }
 
     /// (Cell, orientation) nodes the heuristic's cost-to-go has settled so far (with
     /// those of the earlier searches, when the tables came from a [`HeuristicCache`]).
     pub fn cost_to_go_nodes(&self) -> usize {
-        self.heuristic.get().map_or(0, |t| t.cost_to_go.settled())
+        self.heuristic.get().map_or(0, |(t, _)| t.cost_to_go.settled())
     }
 
     /// Number of foot components the step bound found (0: no step bound).
@@ -1030,8 +1030,8 @@ impl<'c> HybridGraph<'c> {
         let world = Self::feet_xyz(feet);
         let rule = &self.config.motion.standing;
         let (terrain, swept) = (self.maps.leg_terrain(), self.maps.swept_leg_terrain());
-        let (p, _, _, swept) = rule
-            .stand_legs_clear_of(&self.robot, terrain, swept, world, [pose.x, pose.y], pose.theta)
+        let (p, _, swept) = rule
+            .stand_clear_of(&self.robot, terrain, swept, world, [pose.x, pose.y], pose.theta)
             .ok()?;
         self.feasibility.body_clear(&p, self.maps).ok()?;
         let hips = hips_in_world(&self.robot, &p);

@@ -197,19 +197,19 @@ impl StandingRule {
         xy: [f64; 2],
         yaw: f64,
     ) -> Result<(Posture, f64), PostureError> {
-        self.stand_legs_within(robot, (terrain, None), feet, xy, yaw).map(|(p, h, _, _)| (p, h))
+        self.stand_within(robot, (terrain, None), feet, xy, yaw).map(|(p, h, _)| (p, h))
     }
 
-    /// [`Self::stand`] on `terrain` with the posture's solved legs, and whether the posture's legs also clear
-    /// `wider` ([`Self::legs_clear`]): heights at least `terrain`'s wherever `terrain`
-    /// knows one (a wider dilation of the same map, as `CostMaps::swept_leg_terrain` is
-    /// of `CostMaps::leg_terrain`). `wider` is checked first at each height: legs clear
+    /// [`Self::stand`] on `terrain`, and whether the posture's legs also clear `wider`
+    /// ([`Self::legs_clear`]): heights at least `terrain`'s wherever `terrain` knows one
+    /// (a wider dilation of the same map, as `CostMaps::swept_leg_terrain` is of
+    /// `CostMaps::leg_terrain`). `wider` is checked first at each height: legs clear
     /// of it are clear of `terrain` at the same points, so the common case costs one
     /// clearance check instead of two, and the answer is the same.
     ///
     /// # Errors
     /// As [`Self::stand`].
-    pub fn stand_legs_clear_of(
+    pub fn stand_clear_of(
         &self,
         robot: &RobotDescription,
         terrain: &HeightMap,
@@ -217,19 +217,19 @@ impl StandingRule {
         feet: [[f64; 3]; 4],
         xy: [f64; 2],
         yaw: f64,
-    ) -> Result<(Posture, f64, SolvedLegs, bool), PostureError> {
-        self.stand_legs_within(robot, (terrain, Some(wider)), feet, xy, yaw)
+    ) -> Result<(Posture, f64, bool), PostureError> {
+        self.stand_within(robot, (terrain, Some(wider)), feet, xy, yaw)
     }
 
-    /// [`Self::stand_legs_clear_of`], `wider` optional (none: `false`).
-    fn stand_legs_within(
+    /// [`Self::stand_clear_of`], `wider` optional (none: `false`).
+    fn stand_within(
         &self,
         robot: &RobotDescription,
         (terrain, wider): (&HeightMap, Option<&HeightMap>),
         feet: [[f64; 3]; 4],
         xy: [f64; 2],
         yaw: f64,
-    ) -> Result<(Posture, f64, SolvedLegs, bool), PostureError> {
+    ) -> Result<(Posture, f64, bool), PostureError> {
         let pitch = self.pitch(&feet, yaw);
         let ground = feet.map(|f| f[2]);
         let frame = BaseFrame::new([0.0, pitch, yaw]);
@@ -249,10 +249,10 @@ impl StandingRule {
                 }
             };
             if wider.is_some_and(|w| self.legs_clear(robot, w, &legs).is_ok()) {
-                return Ok((p, h, legs, true));
+                return Ok((p, h, true));
             }
             match self.legs_clear(robot, terrain, &legs) {
-                Ok(()) => return Ok((p, h, legs, false)),
+                Ok(()) => return Ok((p, h, false)),
                 Err(e) => last = Some(e),
             }
         }
@@ -957,13 +957,13 @@ mod tests {
                 let (wx, wy) = (x + cs * fx - sn * fy, y + sn * fx + cs * fy);
                 [wx, wy, heights.height_at_cell(wx, wy).unwrap()]
             });
-            let both = r.stand_legs_clear_of(&robot, &plain, &wider, feet, [x, y], yaw);
+            let both = r.stand_clear_of(&robot, &plain, &wider, feet, [x, y], yaw);
             let apart = r.stand(&robot, &plain, feet, [x, y], yaw).map(|(p, h)| {
                 let legs = solve_chains(&robot, &p, r.reach_margin_m).unwrap();
                 (p, h, r.legs_clear(&robot, &wider, &legs).is_ok())
             });
             match (both, apart) {
-                (Ok((p, h, _, clear)), Ok((q, g, also))) => {
+                (Ok((p, h, clear)), Ok((q, g, also))) => {
                     assert_eq!((p, h, clear), (q, g, also), "case {n}");
                     seen[usize::from(clear)] += 1;
                 }
