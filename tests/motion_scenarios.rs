@@ -280,3 +280,36 @@ fn generated_step_courses_expand_as_planned() {
         assert_eq!(d.steps, p.steps);
     }
 }
+
+/// Blocks above ~0.21 m (`momaro generate --class up_and_over`, seeds 32 and 52: 0.225
+/// and 0.217 m high). A front foot onto such a block holds only below the shared rule's
+/// two tallest leg heights: there, the stance rolled over the support triangle leaves the
+/// stretched rear leg on the stepping side out of reach. The planner's step check tried
+/// only those two, searched every pose and answered "no path"; it now tries every
+/// height, as the generator does. Both courses are planned, and expand as planned.
+#[test]
+fn generated_blocks_above_the_two_tallest_stances_are_planned_and_expand() {
+    use momaro::jobs::generate::checked_case;
+    use momaro::scenario::generate::Class;
+    let mut sim = sim();
+    let robot = sim.robot().clone();
+    let dir = common::temp_dir("generated_tall_blocks");
+    for seed in [32, 52] {
+        let (case, _) = checked_case(Class::UpAndOver, seed, &dir, &robot).expect("generated");
+        let s = case.scenario(&dir).expect("scenario");
+        // The probe's path (`plan --schedule-expansions 0`): the schedule to ε = 3 takes
+        // 15–20 s here in release and proves nothing more.
+        let opts = PlanOptions {
+            time_limit_s: 600.0,
+            final_epsilon: Some(3.0),
+            schedule_expansions: Some(0),
+            ..PlanOptions::default()
+        };
+        let p = plan::run(&s, sim.robot(), &opts).expect("plan");
+        assert!(p.steps >= 8, "{}: {} steps planned", s.name, p.steps);
+        let d = expand(&s, &mut sim, &p.path).unwrap_or_else(|e| panic!("{}: {e}", s.name));
+        report(&s, p.path.len(), p.path.len(), &d);
+        check(&d, &sim);
+        assert_eq!(d.steps, p.steps);
+    }
+}

@@ -427,12 +427,14 @@ height = 0.4
 }
 
 /// ARA*'s probe (issue 15): on a generated up-and-over course (`generate --class
-/// up_and_over --seed 27`) the paper's ε = 3 search floods a plateau and is still without
-/// a path after 100,000 expansions; the probe at ε = 50 finds one within 200, and it is
-/// the answer when the cap stops the schedule, with its bound.
+/// up_and_over --seed 21`) the paper's ε = 3 search floods a plateau and is still without
+/// a path after 100,000 expansions (none in 468 k); the probe at ε = 50 finds one within
+/// 200, and it is the answer when the cap stops the schedule, with its bound. (Seed 27
+/// showed this until the planner's step check tried every leg height: its ε = 3 search
+/// now finds a path in 10 k expansions.)
 #[test]
 fn the_probe_answers_where_the_schedule_runs_out() {
-    let s = common::generated(momaro::scenario::generate::Class::UpAndOver, 27);
+    let s = common::generated(momaro::scenario::generate::Class::UpAndOver, 21);
     let capped = PlanOptions {
         final_epsilon: Some(3.0),
         schedule_expansions: Some(100_000),

@@ -416,6 +416,21 @@ fn a_generated_step_down_keeps_its_knees_off_the_edge() {
     assert!(s.passed, "{s:#?}");
 }
 
+/// A generated block above the shared rule's two tallest stances (`momaro generate
+/// --class up_and_over --seed 52`: 0.217 m, edges at −12.9° to the path), which the planner
+/// called impassable while its step check tried only those two heights
+/// (`motion_scenarios`): climbed and left in closed loop, every step lifted, no static
+/// violation. The probe's path, as `plan --schedule-expansions 0` finds it.
+#[test]
+fn a_generated_block_above_the_two_tallest_stances_is_climbed_in_closed_loop() {
+    let sc = common::generated(momaro::scenario::generate::Class::UpAndOver, 52);
+    let plan = PlanOptions { schedule_expansions: Some(0), ..plan_options() };
+    let s = run::run(&sc, &RunOptions::new(plan, common::model())).expect("run");
+    assert!(s.steps_planned >= 8, "{s:#?}");
+    assert_clean(&s);
+    assert!(s.passed, "{s:#?}");
+}
+
 /// Plans scenario `name` with the paper's lift threshold and executes it with one no
 /// posture meets (30 cm, for the executor only), so that its first step is aborted:
 /// the run and the simulation it ran in.

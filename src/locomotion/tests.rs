@@ -456,6 +456,29 @@ mod hybrid {
     }
 
     #[test]
+    fn front_steps_onto_a_block_taller_than_the_two_tallest_stances_allow() {
+        // A front foot onto 0.24 m: at the two tallest leg heights of the shared rule
+        // (0.35 and 0.34 m for this step) the stance rolled toward the support triangle
+        // leaves the stretched rear leg on that side no reach; from 0.31 m down it holds.
+        // The planner once tried only those two heights and refused every block above
+        // ~0.21 m (generated up-and-over courses of 0.22–0.25 m: "no path").
+        let maps = platform_maps(0.24);
+        let mut g = graph(&maps, LatticeState::new(0, 0, 0));
+        let s = state_at(&g, 0.5, 0.0);
+        let legs: Vec<_> = g
+            .labelled_successors(s)
+            .into_iter()
+            .filter(|(_, _, m)| m.kind == ManoeuvreKind::Step)
+            .map(|(_, _, m)| (m.leg, m.step.expect("step details").height_m))
+            .collect();
+        assert_eq!(legs.len(), 2, "{legs:?}");
+        for (leg, height) in legs {
+            assert!(matches!(leg, Some(Leg::FrontLeft | Leg::FrontRight)));
+            assert!((height - 0.24).abs() < 1e-9, "{height}");
+        }
+    }
+
+    #[test]
     fn base_shift_after_both_front_steps_costs_c_bs() {
         let maps = platform_maps(0.2);
         let mut g = graph(&maps, LatticeState::new(0, 0, 0));

@@ -48,14 +48,18 @@
 //! holds is taken; otherwise [`MotionError::Step`] names the step, the leg and the best
 //! margin reached.
 //!
-//! **The planner runs the same check** ([`ManoeuvreCheck::step`], [`StepSearch::Planner`]): the
-//! first two heights with full wheel alignment and every roll and shift fraction, a
-//! subset of the generator's candidates, from the shared rule's standing posture at the
-//! planned pose ([`StandingRule::stand`]). The generator settles into that posture before
-//! every step and wheel move (a `stand_up` keyframe where the manoeuvre before left the
-//! base elsewhere), so a step the planner admits meets a candidate here that holds; only
-//! the CoM model differs (the planner's estimate, MuJoCo's here), and the planner keeps
-//! 3 mm of margin for that.
+//! **The planner runs the same check** ([`ManoeuvreCheck::step`], [`StepSearch::Planner`]):
+//! every height with full wheel alignment and every roll and shift fraction, a subset of
+//! the generator's candidates, from the shared rule's standing posture at the planned pose
+//! ([`StandingRule::stand`]). Heights are taken lazily, the next only when every candidate
+//! at the ones before failed, so a step that holds tall costs no more. Tall steps hold
+//! only lower down: a front foot onto 0.24 m holds first at 0.31 m of leg height, where
+//! the rolled stance leaves the stretched rear leg on the same side its reach (when the
+//! planner tried only the two tallest heights, it called every block above ~0.21 m
+//! impassable). The generator settles into that posture before every step and wheel move
+//! (a `stand_up` keyframe where the manoeuvre before left the base elsewhere), so a step
+//! the planner admits meets a candidate here that holds; only the CoM model differs (the
+//! planner's estimate, MuJoCo's here), and the planner keeps 3 mm of margin for that.
 
 use super::CenterOfMassModel;
 use super::keyframe::{DetailedPath, Keyframe, Phase};
@@ -781,7 +785,7 @@ impl<'a> Expander<'a> {
             (f64::NEG_INFINITY, self.o.min_margin_m, "no candidate".to_owned());
         let candidates: Box<dyn Iterator<Item = (f64, f64, f64, Shift)>> = match search {
             StepSearch::Planner => {
-                Box::new(heights.take(PLANNER_STEP_HEIGHTS).flat_map(|h| {
+                Box::new(heights.flat_map(|h| {
                     PLANNER_ALIGNMENTS.map(|(rf, f)| (h, 1.0, rf, Shift::Remainder(f)))
                 }))
             }
@@ -917,7 +921,7 @@ impl<'a> Expander<'a> {
 /// Which step candidates the expansion tries (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StepSearch {
-    /// The planner's: the first [`PLANNER_STEP_HEIGHTS`] heights of the shared rule, the
+    /// The planner's: every height of the shared rule, tallest first, with the
     /// partner wheel's full alignment, no, full or half roll, and none, all or half of
     /// the remaining base shift. Every one of them is also a [`StepSearch::Full`]
     /// candidate, so a step the planner admits is one the generator expands.
@@ -926,10 +930,6 @@ pub enum StepSearch {
     /// fixed base shifts.
     Full,
 }
-
-/// Leg heights of the shared rule the planner's step check tries. On the paper's
-/// scenarios and generated step courses the generator's steps held at the first or second.
-pub const PLANNER_STEP_HEIGHTS: usize = 2;
 
 /// The generator's candidates (leg height, wheel fraction, roll fraction, shift) at
 /// `heights`, in the order tried (see the module docs).
