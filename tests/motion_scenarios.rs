@@ -26,14 +26,18 @@ fn sim() -> Simulation {
     Simulation::robot_only(&default_model_path()).expect("model compiles")
 }
 
-fn planned(s: &Scenario, sim: &Simulation) -> PlanSummary {
-    let opts = PlanOptions {
+/// ARA*'s first solution at ε = 3: the same plan on any machine.
+fn first_solution() -> PlanOptions {
+    PlanOptions {
         algorithm: Algorithm::AraStar,
         time_limit_s: 600.0,
         final_epsilon: Some(3.0),
         ..PlanOptions::default()
-    };
-    plan::run(s, sim.robot(), &opts).expect("plan")
+    }
+}
+
+fn planned(s: &Scenario, sim: &Simulation) -> PlanSummary {
+    plan::run(s, sim.robot(), &first_solution()).expect("plan")
 }
 
 fn expand(
@@ -264,21 +268,7 @@ height = 0.1
 /// came out of reach in the generator's re-centred stance.
 #[test]
 fn generated_step_courses_expand_as_planned() {
-    use momaro::jobs::generate::checked_case;
-    use momaro::scenario::generate::Class;
-    let mut sim = sim();
-    let robot = sim.robot().clone();
-    let dir = common::temp_dir("generated_step_courses");
-    for seed in [59, 83] {
-        let (case, _) = checked_case(Class::UpAndOver, seed, &dir, &robot).expect("generated");
-        let s = case.scenario(&dir).expect("scenario");
-        let p = planned(&s, &sim);
-        assert!(p.steps > 0, "{}: no steps planned", s.name);
-        let d = expand(&s, &mut sim, &p.path).unwrap_or_else(|e| panic!("{}: {e}", s.name));
-        report(&s, p.path.len(), p.path.len(), &d);
-        check(&d, &sim);
-        assert_eq!(d.steps, p.steps);
-    }
+    expand_generated_up_and_over("generated_step_courses", &[59, 83], &first_solution());
 }
 
 /// Blocks above ~0.21 m (`momaro generate --class up_and_over`, seeds 32 and 52: 0.225
@@ -289,23 +279,25 @@ fn generated_step_courses_expand_as_planned() {
 /// height, as the generator does. Both courses are planned, and expand as planned.
 #[test]
 fn generated_blocks_above_the_two_tallest_stances_are_planned_and_expand() {
+    // The probe's path (`plan --schedule-expansions 0`): the schedule to ε = 3 takes
+    // 15–20 s here in release and proves nothing more.
+    let opts = PlanOptions { schedule_expansions: Some(0), ..first_solution() };
+    expand_generated_up_and_over("generated_tall_blocks", &[32, 52], &opts);
+}
+
+/// Plans the generated up-and-over courses `seeds` with `opts` and expands each plan:
+/// at least one step per foot onto and off the block (8), every keyframe checked, every
+/// planned step expanded.
+fn expand_generated_up_and_over(dir: &str, seeds: &[u64], opts: &PlanOptions) {
     use momaro::jobs::generate::checked_case;
     use momaro::scenario::generate::Class;
     let mut sim = sim();
     let robot = sim.robot().clone();
-    let dir = common::temp_dir("generated_tall_blocks");
-    for seed in [32, 52] {
+    let dir = common::temp_dir(dir);
+    for &seed in seeds {
         let (case, _) = checked_case(Class::UpAndOver, seed, &dir, &robot).expect("generated");
         let s = case.scenario(&dir).expect("scenario");
-        // The probe's path (`plan --schedule-expansions 0`): the schedule to ε = 3 takes
-        // 15–20 s here in release and proves nothing more.
-        let opts = PlanOptions {
-            time_limit_s: 600.0,
-            final_epsilon: Some(3.0),
-            schedule_expansions: Some(0),
-            ..PlanOptions::default()
-        };
-        let p = plan::run(&s, sim.robot(), &opts).expect("plan");
+        let p = plan::run(&s, sim.robot(), opts).expect("plan");
         assert!(p.steps >= 8, "{}: {} steps planned", s.name, p.steps);
         let d = expand(&s, &mut sim, &p.path).unwrap_or_else(|e| panic!("{}: {e}", s.name));
         report(&s, p.path.len(), p.path.len(), &d);
