@@ -353,6 +353,16 @@ pub enum ExecEventKind {
         /// a smaller angle (forward, then backward, or the other way).
         rolls: usize,
     },
+    /// Before a step the feet stood more than a cell from the plan's footholds, but no
+    /// roll back keeps every pair on the ground it stands on (narrow treads: a pair
+    /// steered across puts a wheel over the nosing), and the part along the heading is
+    /// within a cell: the step goes ahead from where the stance is.
+    SlideRefused {
+        /// The stance's offset measured from the wheel contacts, m.
+        offset_m: f64,
+        /// Its part across the heading (positive: to the robot's left), m.
+        lateral_m: f64,
+    },
     /// A stabilising base correction toward the support centroid.
     Correction {
         /// The stepping leg.
