@@ -286,6 +286,16 @@ mod hybrid {
         HybridConfig::new(&Params::default(), &robot(), Neighbourhood::N16)
     }
 
+    /// The abstract steps among `s`'s successors, in the graph's order.
+    fn step_edges(
+        g: &mut HybridGraph<'_>,
+        s: LatticeState,
+    ) -> Vec<(LatticeState, Cost, Manoeuvre)> {
+        let mut all = g.labelled_successors(s);
+        all.retain(|(_, _, m)| m.kind == ManoeuvreKind::Step);
+        all
+    }
+
     #[test]
     fn a_graph_asked_only_for_edges_builds_no_heuristic() {
         // `jobs::plan` prices a path on a second graph (k12 = 1) through `edge` alone;
@@ -398,11 +408,7 @@ mod hybrid {
         // Front feet at x = 0.5125 + 0.35 = 0.8625, 0.1375 m before the edge: within
         // 0.1 m of the infinite band (0.12 m around the edge cells at 0.9875 / 1.0125).
         let s = state_at(&g, 0.505, 0.0);
-        let steps: Vec<_> = g
-            .labelled_successors(s)
-            .into_iter()
-            .filter(|(_, _, m)| m.kind == ManoeuvreKind::Step)
-            .collect();
+        let steps = step_edges(&mut g, s);
         let legs: Vec<_> = steps.iter().map(|(_, _, m)| m.leg).collect();
         assert_eq!(legs, vec![Some(Leg::FrontLeft), Some(Leg::FrontRight)]);
         for (t, c, m) in &steps {
@@ -465,10 +471,8 @@ mod hybrid {
         let maps = platform_maps(0.24);
         let mut g = graph(&maps, LatticeState::new(0, 0, 0));
         let s = state_at(&g, 0.5, 0.0);
-        let legs: Vec<_> = g
-            .labelled_successors(s)
+        let legs: Vec<_> = step_edges(&mut g, s)
             .into_iter()
-            .filter(|(_, _, m)| m.kind == ManoeuvreKind::Step)
             .map(|(_, _, m)| (m.leg, m.step.expect("step details").height_m))
             .collect();
         assert_eq!(legs.len(), 2, "{legs:?}");
@@ -888,11 +892,7 @@ mod hybrid {
                 let base = state_at(&a, 0.025 * f64::from(k), 0.0);
                 let of = |g: &mut HybridGraph<'_>| -> Vec<_> {
                     let s = g.with_offsets(base, [o, o, 0, 0]).expect("interned");
-                    g.labelled_successors(s)
-                        .into_iter()
-                        .filter(|(_, _, m)| m.kind == ManoeuvreKind::Step)
-                        .map(|(t, c, m)| (g.offsets(t), c, m.leg))
-                        .collect()
+                    step_edges(g, s).into_iter().map(|(t, c, m)| (g.offsets(t), c, m.leg)).collect()
                 };
                 let (sa, sb) = (of(&mut a), of(&mut b));
                 steps += sa.len();

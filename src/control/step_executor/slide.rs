@@ -252,17 +252,13 @@ impl StepExecutor {
             None => {
                 // Off by more than a cell with no roll that keeps the ground: said, so a
                 // drift that builds up step by step on narrow treads is not silent.
-                if let Some(o) = offset
-                    && o[0].hypot(o[1]) > self.config.slide_threshold_m
-                {
-                    let (s, c) = self.cmd.base_rpy[2].sin_cos();
-                    self.event(
-                        obs.time,
-                        ExecEventKind::SlideRefused {
-                            offset_m: o[0].hypot(o[1]),
-                            lateral_m: -o[0] * s + o[1] * c,
-                        },
-                    );
+                if let Some(o) = offset {
+                    let offset_m = o[0].hypot(o[1]);
+                    if offset_m > self.config.slide_threshold_m {
+                        let (s, c) = self.cmd.base_rpy[2].sin_cos();
+                        let lateral_m = -o[0] * s + o[1] * c;
+                        self.event(obs.time, ExecEventKind::SlideRefused { offset_m, lateral_m });
+                    }
                 }
                 self.proceed(index)
             }
