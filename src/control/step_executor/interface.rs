@@ -344,13 +344,17 @@ pub enum ExecEventKind {
     /// Before a step the feet stood this far from the plan's footholds, and the robot
     /// rolled back onto them (`step_executor::slide`).
     Slide {
-        /// The stance's offset measured from the wheel contacts, m.
+        /// The stance's offset measured from the wheel contacts (its feet's centroid), m.
         offset_m: f64,
-        /// How far the slide takes the stance: the whole offset, or its part along the
-        /// heading where no pair steering keeps the ground it stands on, m.
+        /// How far the stance is turned from the plan (counter-clockwise), rad.
+        yaw_rad: f64,
+        /// How far the slide moves the base, m.
         slid_m: f64,
-        /// In how many rolls: 2 where the pairs cannot steer straight back but can at
-        /// a smaller angle (forward, then backward, or the other way).
+        /// How far the slide turns it, rad.
+        turned_rad: f64,
+        /// In how many rolls: the turn alone first where the pairs cannot steer to the
+        /// whole of it, and the shift in two where they cannot steer straight back but
+        /// can at a smaller angle (forward, then backward, or the other way).
         rolls: usize,
     },
     /// Before a step the feet stood more than a cell from the plan's footholds, but no
@@ -358,10 +362,12 @@ pub enum ExecEventKind {
     /// steered across puts a wheel over the nosing), and the part along the heading is
     /// within a cell: the step goes ahead from where the stance is.
     SlideRefused {
-        /// The stance's offset measured from the wheel contacts, m.
+        /// The stance's offset measured from the wheel contacts (its feet's centroid), m.
         offset_m: f64,
         /// Its part across the heading (positive: to the robot's left), m.
         lateral_m: f64,
+        /// How far the stance is turned from the plan (counter-clockwise), rad.
+        yaw_rad: f64,
     },
     /// A stabilising base correction toward the support centroid.
     Correction {

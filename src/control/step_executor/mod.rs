@@ -38,11 +38,12 @@
 //!   correction the guard added).
 //! - **Before a step** (the first keyframe of a path element that lifts a foot) the
 //!   stance is brought back onto the plan's footholds if the wheel contacts MuJoCo
-//!   reports put it more than [`ExecutorConfig::slide_threshold_m`] off them: the pairs
-//!   steer and roll the robot, legs held, where the height map says a steered pair keeps
-//!   its ground (`slide`). The legs cannot move the stance sideways, yet a planned base
-//!   shift ends on a lattice cell up to half a cell to the side of its heading, and
-//!   stance wheels creep.
+//!   reports put a foot more than [`ExecutorConfig::slide_threshold_m`] off its
+//!   foothold: the pairs steer and roll the robot, turned and shifted, legs held, where
+//!   the height map says a steered pair keeps its ground (`slide`). The legs cannot move
+//!   or turn the stance, yet a planned base shift ends on a lattice cell up to half a
+//!   cell to the side of its heading, stance wheels creep, and a base rolled while
+//!   pitched less than its feet's line turns the robot.
 //! - **Before a lift** the support margin measured from MuJoCo (CoM over the wheel
 //!   contacts of the three support legs) must reach [`ExecutorConfig::min_lift_margin_m`]
 //!   (2 cm) plus a reserve for the sag of the compliant support legs when the foot unloads
@@ -106,7 +107,7 @@ pub use interface::{
     Command, ExecEvent, ExecEventKind, ExecFailure, ExecStatus, ExecutorConfig, Observation,
     Stranding,
 };
-pub use slide::stance_offset;
+pub use slide::{StanceError, stance_error};
 pub use timing::{clock_rate, motion_duration, smoothstep, smoothstep_rate};
 
 use super::foot_contact::ContactConfirm;
@@ -153,8 +154,8 @@ enum Mode {
     /// Rolling the stance back onto its footholds before keyframe `index` (`slide`).
     Slide {
         index: usize,
-        start: [f64; 2],
-        rolls: [[f64; 2]; 2],
+        start: Pose2,
+        rolls: Vec<slide::Roll>,
         roll: usize,
         elapsed: f64,
         rolling: bool,

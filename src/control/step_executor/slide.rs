@@ -1,8 +1,8 @@
 //! The stance slide: before a step, the whole robot rolls on its four wheel pairs, legs
-//! held, until its feet stand on the plan's footholds again.
+//! held, until its feet stand on the plan's footholds again, turned as the plan has them.
 //!
 //! Why it is needed: the legs move only in their sagittal planes, so nothing else can
-//! move the stance sideways, yet the plan asks for it. A planned base shift ends on the
+//! move or turn the stance, yet the plan asks for it. A planned base shift ends on the
 //! lattice cell nearest its length along the heading, and its footprint moves with the
 //! base (`motion::expand`: "the wheels roll that far"); off the grid's axes that is up to
 //! half a cell sideways per shift. Stance wheels also creep under the legs' push (velocity
@@ -10,35 +10,49 @@
 //! stood 5 cm from their footholds after 12 steps, the base 13 cm to the side of the plan
 //! after 24, and the run was stranded by drift; the position hold
 //! (`StepExecutor::hold_base`) saturated at its 4 cm trying to carry the base back over
-//! feet that were themselves off.
+//! feet that were themselves off. And the stance turns: a base rolled (eqs. 6–8) while
+//! it is pitched less than the line through its front and rear feet (70 % of the slope,
+//! Sec. VI-B) cannot roll about its own x' axis with every foot on its leg's plane; the
+//! rigid robot rolls about the feet's line instead, which turns it (measured on a flight
+//! of 0.156 m rises, rolled 0.2 rad at 0.35 rad of pitch: 0.03–0.04 rad), and rolled back
+//! after a step the feet's line has changed, so the turn stays. A stance 0.03 rad off its
+//! heading carries its base sideways by 0.03 m per metre of base shift; on generated
+//! stairs the stance drifted 5 cm sideways and 0.05 rad before a stretched leg lost its
+//! tread and the robot fell.
 //!
 //! How: at the first keyframe of a path element that lifts a foot
-//! ([`StepExecutor::starts_a_step`]), the stance's offset from the plan is measured from
-//! the wheel contacts MuJoCo reports ([`stance_offset`]: each leg whose two wheels touch
-//! stands at their midpoint). Beyond [`ExecutorConfig::slide_threshold_m`] (a cell) every
-//! pair steers to the way back (the wheel kinematics' shortest way, at most 90°) and
-//! rolls at the same velocity, a pure translation, until the measured base has moved by
-//! the offset (closed loop on the base, at most [`ExecutorConfig::slide_speed_mps`],
-//! given up after [`ExecutorConfig::max_slide_s`]); then the pairs steer straight again
-//! before the step's first segment. The legs keep their targets (the holds are frozen),
-//! so the relative geometry of base and feet does not change.
+//! ([`StepExecutor::starts_a_step`]), the stance's error is measured from the wheel
+//! contacts MuJoCo reports ([`stance_error`]: each leg whose two wheels touch stands at
+//! their midpoint; the shift and turn that best take the footholds onto them). Where a
+//! foot stands more than [`ExecutorConfig::slide_threshold_m`] (a cell) from its foothold,
+//! every pair steers to its own way back (the wheel kinematics of the body twist that
+//! turns and shifts the robot back; at most 90° of steering) and rolls, until the measured
+//! base pose has turned and moved by the error (closed loop on the base, pairs at most
+//! [`ExecutorConfig::slide_speed_mps`], given up after [`ExecutorConfig::max_slide_s`]);
+//! then the pairs steer straight again before the step's first segment. The legs keep
+//! their targets (the holds are frozen), so the relative geometry of base and feet does
+//! not change.
 //!
 //! A pair steered across its tread puts a wheel over the nosing or against the riser
 //! (measured: steering regardless, 4 of 30 generated flights aborted a step, 13 cm of
 //! margin gone to 3 cm). So each roll is checked on the height map first
-//! ([`StepExecutor::steering_keeps_the_ground`]: the steered pair must rest as the
-//! straight one does); where the way straight back fails, the sideways part goes in two
-//! rolls at a smaller angle (forward and backward at ±60° … ±20°, their parts along the
-//! heading cancelling), and where those fail too, only the part along the heading is
-//! rolled, straight, over footholds the plan checked. Where that part is within a cell,
-//! nothing rolls: the step goes ahead from where the stance is, and the run's events say
-//! so (`SlideRefused`, with the sideways part). On narrow treads every step can end here:
-//! a generated flight of 0.284 m treads drifted 5 cm sideways over eight such refusals
-//! before a stretched leg lost its tread.
+//! ([`StepExecutor::steering_keeps_the_ground`]: every steered pair must rest as the
+//! straight one does, where it starts and where it ends). Where the whole way back fails,
+//! the turn goes first on its own: on the spot (each pair 40–50° from the heading), or
+//! where that fails in two arcs of half the turn about centres to either side (0.6–2 m
+//! away, steering 45–11°; one arc forward and one backward, like a three-point turn);
+//! then the shift: straight back; or its sideways part in two rolls at a smaller angle
+//! (forward and backward at ±60° … ±20°, their parts along the heading cancelling); or
+//! only its part along the heading, straight, over footholds the plan checked. Where
+//! nothing can be rolled, the step goes ahead from where the stance is, and the run's
+//! events say so (`SlideRefused`, with the sideways part and the turn). On generated
+//! flights of 0.284 m treads the arcs turn the stance back where nothing else could
+//! (30 generated flights: the one fall is gone, see the README's "Stance slide").
 
 use super::actuation::pairs_in_base;
 use super::{Command, ExecEventKind, ExecutorConfig, Mode, Observation, StepExecutor};
 use crate::control::wheels::Twist;
+use crate::geometry::{Pose2, wrap_angle};
 use crate::motion::Phase;
 use crate::motion::kinematics::Posture;
 use crate::robot::{Leg, RobotDescription};
@@ -60,23 +74,55 @@ const STRAIGHTEN_S: f64 = 2.0;
 /// stance sideways in two rolls where the pairs cannot steer straight across.
 const ZIGZAG_ANGLES: [f64; 4] = [60.0, 45.0, 30.0, 20.0];
 
+/// The radii (m, smallest first) of the two arcs by which a slide turns the stance where
+/// the pairs cannot steer to a turn on the spot: at 0.6 m a pair steers up to about 45°
+/// from the heading, at 2 m about 11°, and the stance rolls turn · radius / 2 along it.
+const TURN_ARC_RADII: [f64; 4] = [0.6, 1.0, 1.5, 2.0];
+
 /// How far a steered pair's wheels may rest from where the straight pair's do, m.
 const STEER_REST_TOLERANCE_M: f64 = 0.005;
 
-/// The planar offset (world x, y, m) of the stance from the plan: the mean, over the legs
-/// the posture `planned` has in contact and whose two wheels both touch, of the midpoint
-/// of the two wheel contacts (the two points of the leg farthest apart, which must lie
-/// between half and one and a half wheel tracks apart) less the planned foot. `None` when
-/// fewer than two legs can be measured (a single contact lies half a track to one side of
-/// its foot, and which side is not known).
-pub fn stance_offset(
+/// Where the stance stands against the plan, measured from the wheel contacts: the planar
+/// rigid motion (least squares) that takes the plan's footholds to the measured feet.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StanceError {
+    /// The planned feet's centroid (world x, y, m), the centre of [`StanceError::yaw`].
+    pub centre: [f64; 2],
+    /// How far the measured feet's centroid stands from it (world x, y, m).
+    pub offset: [f64; 2],
+    /// How far the stance is turned from the plan about its centre (counter-clockwise,
+    /// rad); zero when only two legs are measured (one wheel's bounce would turn it).
+    pub yaw: f64,
+    /// The largest distance of a measured foot from its foothold, m.
+    pub worst_m: f64,
+}
+
+impl StanceError {
+    /// The roll that takes the measured stance back onto the plan's footholds.
+    fn back(&self) -> Roll {
+        let at = [self.centre[0] + self.offset[0], self.centre[1] + self.offset[1]];
+        Roll { centre: at, turn: -self.yaw, shift: [-self.offset[0], -self.offset[1]] }
+    }
+
+    /// The roll that takes the plan's footholds to where the stance is measured.
+    fn forward(&self) -> Roll {
+        Roll { centre: self.centre, turn: self.yaw, shift: self.offset }
+    }
+}
+
+/// The stance's error against posture `planned`, measured over the legs `planned` has in
+/// contact whose two wheels both touch: each such leg stands at the midpoint of its two
+/// wheel contacts (the two points of the leg farthest apart, which must lie between half
+/// and one and a half wheel tracks apart). `None` when fewer than two legs can be
+/// measured (a single contact lies half a track to one side of its foot, and which side
+/// is not known).
+pub fn stance_error(
     robot: &RobotDescription,
     planned: &Posture,
     contacts: &[(Leg, [f64; 2])],
-) -> Option<[f64; 2]> {
+) -> Option<StanceError> {
     let track = robot.wheel_track;
-    let mut sum = [0.0; 2];
-    let mut n = 0usize;
+    let mut pairs: Vec<([f64; 2], [f64; 2])> = Vec::with_capacity(4);
     for leg in Leg::ALL.into_iter().filter(|l| planned.contact[l.index()]) {
         let pts: Vec<[f64; 2]> =
             contacts.iter().filter(|(l, _)| *l == leg).map(|(_, p)| *p).collect();
@@ -94,43 +140,112 @@ pub fn stance_offset(
             continue;
         }
         let f = planned.feet[leg.index()];
-        sum[0] += 0.5 * (a[0] + b[0]) - f[0];
-        sum[1] += 0.5 * (a[1] + b[1]) - f[1];
-        n += 1;
+        pairs.push(([f[0], f[1]], [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]));
     }
-    (n >= 2).then(|| sum.map(|s| s / n as f64))
+    if pairs.len() < 2 {
+        return None;
+    }
+    let n = pairs.len() as f64;
+    let (mut centre, mut measured) = ([0.0; 2], [0.0; 2]);
+    for (p, m) in &pairs {
+        for k in 0..2 {
+            centre[k] += p[k] / n;
+            measured[k] += m[k] / n;
+        }
+    }
+    // The turn that best maps the planned feet about their centroid onto the measured
+    // ones about theirs (2-D Procrustes).
+    let (mut cross, mut dot) = (0.0, 0.0);
+    for (p, m) in &pairs {
+        let (a, b) =
+            ([p[0] - centre[0], p[1] - centre[1]], [m[0] - measured[0], m[1] - measured[1]]);
+        cross += a[0] * b[1] - a[1] * b[0];
+        dot += a[0] * b[0] + a[1] * b[1];
+    }
+    let yaw = if pairs.len() >= 3 { cross.atan2(dot) } else { 0.0 };
+    let worst_m = pairs.iter().map(|(p, m)| (m[0] - p[0]).hypot(m[1] - p[1])).fold(0.0, f64::max);
+    Some(StanceError {
+        centre,
+        offset: [measured[0] - centre[0], measured[1] - centre[1]],
+        yaw,
+        worst_m,
+    })
 }
 
-/// `p` with every foot moved by `by` (world x, y, m).
-fn feet_moved(p: &Posture, by: [f64; 2]) -> Posture {
+/// A rigid planar motion of the whole robot on its wheels, legs held: a turn by `turn`
+/// (rad, counter-clockwise) about `centre` (world x, y, m), then a shift by `shift`
+/// (world, m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Roll {
+    centre: [f64; 2],
+    turn: f64,
+    shift: [f64; 2],
+}
+
+impl Roll {
+    /// A shift with no turn.
+    fn straight(shift: [f64; 2]) -> Self {
+        Self { centre: [0.0; 2], turn: 0.0, shift }
+    }
+
+    /// Where the roll takes the world point `x`.
+    fn apply(&self, x: [f64; 2]) -> [f64; 2] {
+        let (s, c) = self.turn.sin_cos();
+        let d = [x[0] - self.centre[0], x[1] - self.centre[1]];
+        [
+            c * d[0] - s * d[1] + self.centre[0] + self.shift[0],
+            s * d[0] + c * d[1] + self.centre[1] + self.shift[1],
+        ]
+    }
+
+    /// Where the roll takes the base pose `b`.
+    fn apply_pose(&self, b: Pose2) -> Pose2 {
+        let [x, y] = self.apply([b.x, b.y]);
+        Pose2::new(x, y, b.theta + self.turn)
+    }
+}
+
+/// `p` with the whole robot (feet, base) moved by `roll`.
+fn rolled(p: &Posture, roll: &Roll) -> Posture {
     let mut q = *p;
     for f in q.feet.iter_mut() {
-        f[0] += by[0];
-        f[1] += by[1];
+        let [x, y] = roll.apply([f[0], f[1]]);
+        f[0] = x;
+        f[1] = y;
     }
+    let b = roll.apply_pose(Pose2::new(p.base_position[0], p.base_position[1], p.base_rpy[2]));
+    q.base_position[0] = b.x;
+    q.base_position[1] = b.y;
+    q.base_rpy[2] = b.theta;
     q
 }
 
-/// The twist (robot frame) that moves a robot at heading `yaw` toward a remaining world
-/// displacement `remaining`: along it at `SLIDE_GAIN` per metre left, at most `max_speed`.
-fn slide_twist(remaining: [f64; 2], yaw: f64, max_speed: f64) -> Twist {
-    let d = remaining[0].hypot(remaining[1]);
-    if d < 1e-12 {
+/// The twist (robot frame) that moves a robot at pose `at` toward pose `target` on its
+/// wheels: translation and turn each at `SLIDE_GAIN` per unit left, scaled together so
+/// that no pair (`reach`: the farthest pair's distance from the base origin, m) moves
+/// faster than about `max_speed`.
+fn slide_twist(at: Pose2, target: Pose2, reach: f64, max_speed: f64) -> Twist {
+    let remaining = [target.x - at.x, target.y - at.y];
+    let turn = wrap_angle(target.theta - at.theta);
+    let (vx_w, vy_w) = (SLIDE_GAIN * remaining[0], SLIDE_GAIN * remaining[1]);
+    let wz = SLIDE_GAIN * turn;
+    let fastest = vx_w.hypot(vy_w) + wz.abs() * reach;
+    if fastest < 1e-12 {
         return Twist::default();
     }
-    let v = (SLIDE_GAIN * d).min(max_speed) / d;
-    let (s, c) = yaw.sin_cos();
-    let (wx, wy) = (remaining[0] * v, remaining[1] * v);
-    Twist { vx: c * wx + s * wy, vy: -s * wx + c * wy, wz: 0.0 }
+    let k = (max_speed / fastest).min(1.0);
+    let (s, c) = at.theta.sin_cos();
+    Twist { vx: k * (c * vx_w + s * vy_w), vy: k * (-s * vx_w + c * vy_w), wz: k * wz }
 }
 
 impl StepExecutor {
-    /// Whether every wheel pair of posture `p` in contact, at its foot and at its foot
-    /// moved by `by` (world, m), rests on the height map with its wheels across the
-    /// rolling direction `psi` (world yaw, rad) as it does steered straight, within
+    /// Whether every wheel pair of posture `p` in contact, where it stands and where
+    /// `roll` takes it, rests on the height map with its wheels across the direction it
+    /// rolls in (world yaw) as it does steered straight, within
     /// [`STEER_REST_TOLERANCE_M`]: on a tread, a pair steered across the heading can put a
-    /// wheel over the nosing or against the riser the straight pair keeps clear of.
-    fn steering_keeps_the_ground(&self, p: &Posture, by: [f64; 2], psi: f64) -> bool {
+    /// wheel over the nosing or against the riser the straight pair keeps clear of. A pair
+    /// the roll moves by less than a millimetre keeps its steering.
+    fn steering_keeps_the_ground(&self, p: &Posture, roll: &Roll) -> bool {
         let (r, h) = (self.robot.wheel_radius, self.robot.wheel_track / 2.0);
         let rest = |x: f64, y: f64, yaw: f64, top: f64| {
             let (s, c) = yaw.sin_cos();
@@ -139,12 +254,19 @@ impl StepExecutor {
             Some([a, b])
         };
         let yaw = p.base_rpy[2];
+        let end_yaw = yaw + roll.turn;
         (0..4).filter(|&i| p.contact[i]).all(|i| {
             let f = p.feet[i];
+            let to = roll.apply([f[0], f[1]]);
+            let d = [to[0] - f[0], to[1] - f[1]];
+            if d[0].hypot(d[1]) < 1e-3 {
+                return true;
+            }
+            let psi = d[1].atan2(d[0]);
             // Anything up to a metre above the foot holds a wheel up (a riser included).
             let top = f[2] + 1.0;
-            [[f[0], f[1]], [f[0] + by[0], f[1] + by[1]]].iter().all(|q| {
-                match (rest(q[0], q[1], yaw, top), rest(q[0], q[1], psi, top)) {
+            [([f[0], f[1]], yaw), (to, end_yaw)].iter().all(|(q, straight)| {
+                match (rest(q[0], q[1], *straight, top), rest(q[0], q[1], psi, top)) {
                     (Some(a), Some(b)) => {
                         (0..2).all(|k| (a[k] - b[k]).abs() <= STEER_REST_TOLERANCE_M)
                             || (a[0] - b[1]).abs() <= STEER_REST_TOLERANCE_M
@@ -156,36 +278,109 @@ impl StepExecutor {
         })
     }
 
-    /// The rolls (world displacements, the second zero for one) a stance slide makes for
-    /// a stance offset `offset`, each checked with [`Self::steering_keeps_the_ground`]
-    /// from where it starts: all of the offset back in one roll if the pairs can steer to
-    /// it; else its sideways part in two rolls at the largest of [`ZIGZAG_ANGLES`] from
-    /// the heading that the pairs can steer to (one forward, one backward, their parts
-    /// along the heading adding up to the offset's, in the order that keeps the ground);
-    /// else its part along the heading (rolled straight, over footholds the plan
-    /// checked). `None` if what is left is within the threshold.
-    fn slide_rolls(&self, offset: [f64; 2]) -> Option<[[f64; 2]; 2]> {
-        let back = [-offset[0], -offset[1]];
-        let threshold = self.config.slide_threshold_m;
-        if back[0].hypot(back[1]) <= threshold {
+    /// Whether the rolls, one after the other from the stance `from`, each keep the
+    /// ground ([`Self::steering_keeps_the_ground`]).
+    fn rolls_keep_the_ground(&self, from: &Posture, rolls: &[Roll]) -> bool {
+        let mut at = *from;
+        rolls.iter().all(|r| {
+            let ok = self.steering_keeps_the_ground(&at, r);
+            at = rolled(&at, r);
+            ok
+        })
+    }
+
+    /// The rolls a stance slide makes for the stance error `err`, each checked with
+    /// [`Self::steering_keeps_the_ground`] from where it starts: all of the error back in
+    /// one roll (turn and shift) if the pairs can steer to it; else the turn alone about
+    /// the stance's centre where it moves a foot by more than [`SLIDE_DONE_M`] and the
+    /// pairs can steer to it, then the shift as [`Self::shift_rolls`] finds it; else the
+    /// shift alone. `None` if no foot stands more than the threshold from its foothold,
+    /// or nothing can be rolled.
+    fn slide_rolls(&self, err: &StanceError) -> Option<Vec<Roll>> {
+        if err.worst_m <= self.config.slide_threshold_m {
             return None;
         }
         let p = self.with_offsets(&self.cmd);
-        // The feet stand at the planned footholds plus the offset now.
-        let now = feet_moved(&p, offset);
-        let safe = |rolls: &[[f64; 2]]| {
-            let mut at = now;
-            rolls.iter().all(|r| {
-                let ok = self.steering_keeps_the_ground(&at, *r, r[1].atan2(r[0]));
-                at = feet_moved(&at, *r);
-                ok
-            })
-        };
-        if safe(&[back]) {
-            return Some([back, [0.0; 2]]);
+        // The feet stand where the error puts the planned footholds.
+        let now = rolled(&p, &err.forward());
+        let back = err.back();
+        if self.rolls_keep_the_ground(&now, &[back]) {
+            return Some(vec![back]);
         }
-        let (sy, cy) = p.base_rpy[2].sin_cos();
-        let world = |a: f64, l: f64| [a * cy - l * sy, a * sy + l * cy];
+        let reach = (0..4)
+            .map(|i| (now.feet[i][0] - back.centre[0]).hypot(now.feet[i][1] - back.centre[1]))
+            .fold(0.0, f64::max);
+        let mut rolls = Vec::with_capacity(4);
+        if err.yaw.abs() * reach > SLIDE_DONE_M {
+            rolls = self.turn_rolls(&now, back.centre, -err.yaw);
+        }
+        let from = rolls.iter().fold(now, |q, r| rolled(&q, r));
+        // The turns keep the stance's centre where it was, up to the arcs' second order.
+        let centre = rolls.iter().fold(back.centre, |c, r| r.apply(c));
+        let target = [err.centre[0] - centre[0], err.centre[1] - centre[1]];
+        rolls.extend(self.shift_rolls(&from, target));
+        (!rolls.is_empty()).then_some(rolls)
+    }
+
+    /// The rolls that turn the stance `from` by `turn` (rad) about `centre`: the turn on
+    /// the spot if the pairs can steer to it (each pair across its radius, 40–50° from
+    /// the heading); else two arcs of half the turn each, about centres
+    /// [`TURN_ARC_RADII`] to either side (the first arc forward and the second backward,
+    /// or the other way, like a three-point turn), with the smallest radius whose
+    /// steering keeps the ground: at radius R a pair steers about atan(0.35 / (R − 0.32))
+    /// from the heading and the stance rolls turn · R / 2 along it and back. None where
+    /// nothing keeps the ground.
+    fn turn_rolls(&self, from: &Posture, centre: [f64; 2], turn: f64) -> Vec<Roll> {
+        let on_the_spot = Roll { centre, turn, shift: [0.0; 2] };
+        if self.rolls_keep_the_ground(from, &[on_the_spot]) {
+            return vec![on_the_spot];
+        }
+        let half = 0.5 * turn;
+        for radius in TURN_ARC_RADII {
+            for side in [1.0, -1.0] {
+                // The first arc's centre `radius` to the left (side 1) or right of the
+                // stance centre; the second's as far to the other side of where the first
+                // leaves it.
+                let left = |yaw: f64| [-yaw.sin(), yaw.cos()];
+                let yaw = from.base_rpy[2];
+                let n = left(yaw);
+                let first = Roll {
+                    centre: [centre[0] + side * radius * n[0], centre[1] + side * radius * n[1]],
+                    turn: half,
+                    shift: [0.0; 2],
+                };
+                let c1 = first.apply(centre);
+                let n1 = left(yaw + half);
+                let second = Roll {
+                    centre: [c1[0] - side * radius * n1[0], c1[1] - side * radius * n1[1]],
+                    turn: half,
+                    shift: [0.0; 2],
+                };
+                if self.rolls_keep_the_ground(from, &[first, second]) {
+                    return vec![first, second];
+                }
+            }
+        }
+        Vec::new()
+    }
+
+    /// The rolls that shift the stance `from` by `back` (world, m): all of it in one roll
+    /// if the pairs can steer to it; else its sideways part in two rolls at the largest of
+    /// [`ZIGZAG_ANGLES`] from the heading that the pairs can steer to (one forward, one
+    /// backward, their parts along the heading adding up to the shift's, in the order
+    /// that keeps the ground); else its part along the heading (rolled straight, over
+    /// footholds the plan checked) if that is more than the threshold; else none.
+    fn shift_rolls(&self, from: &Posture, back: [f64; 2]) -> Vec<Roll> {
+        let threshold = self.config.slide_threshold_m;
+        if back[0].hypot(back[1]) <= threshold {
+            return Vec::new();
+        }
+        let whole = Roll::straight(back);
+        if self.rolls_keep_the_ground(from, &[whole]) {
+            return vec![whole];
+        }
+        let (sy, cy) = from.base_rpy[2].sin_cos();
+        let world = |a: f64, l: f64| Roll::straight([a * cy - l * sy, a * sy + l * cy]);
         let along = back[0] * cy + back[1] * sy;
         let lateral = -back[0] * sy + back[1] * cy;
         if lateral.abs() > threshold {
@@ -202,13 +397,13 @@ impl StepExecutor {
                 let forward = world(l1 * c, side * l1 * s);
                 let backward = world(-l2 * c, side * l2 * s);
                 for rolls in [[forward, backward], [backward, forward]] {
-                    if safe(&rolls) {
-                        return Some(rolls);
+                    if self.rolls_keep_the_ground(from, &rolls) {
+                        return rolls.to_vec();
                     }
                 }
             }
         }
-        (along.abs() > threshold).then(|| [world(along, 0.0), [0.0; 2]])
+        if along.abs() > threshold { vec![world(along, 0.0)] } else { Vec::new() }
     }
 
     /// Whether keyframe `i` is the first of a path element that lifts a foot (a step's
@@ -225,40 +420,42 @@ impl StepExecutor {
     }
 
     /// Starts work toward keyframe `index`, the first of a step: a stance slide first if
-    /// the feet stand more than the threshold from the plan's footholds (see the module
+    /// a foot stands more than the threshold from the plan's foothold (see the module
     /// docs), then the keyframe's own work.
     pub(super) fn check_stance(&mut self, index: usize, obs: &Observation) {
-        let offset = stance_offset(&self.robot, &self.cmd, &obs.wheel_contacts);
-        match offset.and_then(|o| self.slide_rolls(o).map(|r| (o, r))) {
-            Some((o, rolls)) => {
-                let net = [rolls[0][0] + rolls[1][0], rolls[0][1] + rolls[1][1]];
+        let err = stance_error(&self.robot, &self.cmd, &obs.wheel_contacts);
+        match err.and_then(|e| self.slide_rolls(&e).map(|r| (e, r))) {
+            Some((e, rolls)) => {
+                let start = obs.base;
+                let end = rolls.iter().fold(start, |b, r| r.apply_pose(b));
                 self.event(
                     obs.time,
                     ExecEventKind::Slide {
-                        offset_m: o[0].hypot(o[1]),
-                        slid_m: net[0].hypot(net[1]),
-                        rolls: 1 + usize::from(rolls[1] != [0.0; 2]),
+                        offset_m: e.offset[0].hypot(e.offset[1]),
+                        yaw_rad: e.yaw,
+                        slid_m: (end.x - start.x).hypot(end.y - start.y),
+                        turned_rad: wrap_angle(end.theta - start.theta),
+                        rolls: rolls.len(),
                     },
                 );
-                self.mode = Mode::Slide {
-                    index,
-                    start: [obs.base.x, obs.base.y],
-                    rolls,
-                    roll: 0,
-                    elapsed: 0.0,
-                    rolling: true,
-                };
+                self.mode =
+                    Mode::Slide { index, start, rolls, roll: 0, elapsed: 0.0, rolling: true };
             }
             None => {
                 // Off by more than a cell with no roll that keeps the ground: said, so a
                 // drift that builds up step by step on narrow treads is not silent.
-                if let Some(o) = offset {
-                    let offset_m = o[0].hypot(o[1]);
-                    if offset_m > self.config.slide_threshold_m {
-                        let (s, c) = self.cmd.base_rpy[2].sin_cos();
-                        let lateral_m = -o[0] * s + o[1] * c;
-                        self.event(obs.time, ExecEventKind::SlideRefused { offset_m, lateral_m });
-                    }
+                if let Some(e) = err
+                    && e.worst_m > self.config.slide_threshold_m
+                {
+                    let (s, c) = self.cmd.base_rpy[2].sin_cos();
+                    self.event(
+                        obs.time,
+                        ExecEventKind::SlideRefused {
+                            offset_m: e.offset[0].hypot(e.offset[1]),
+                            lateral_m: -e.offset[0] * s + e.offset[1] * c,
+                            yaw_rad: e.yaw,
+                        },
+                    );
                 }
                 self.proceed(index)
             }
@@ -276,18 +473,17 @@ impl StepExecutor {
     }
 
     /// One tick of a stance slide before keyframe `index`: legs held, every pair in
-    /// contact rolling the robot through `rolls` (world displacements from `start`, where
-    /// the base stood when the slide began; `roll` the one under way), then (`rolling`
-    /// false) the pairs steered straight again before the keyframe's work measures the
-    /// support they stand on.
+    /// contact rolling the robot through `rolls` (from `start`, the base pose when the
+    /// slide began; `roll` the one under way), then (`rolling` false) the pairs steered
+    /// straight again before the keyframe's work measures the support they stand on.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn slide_tick(
         &mut self,
         obs: &Observation,
         dt: f64,
         index: usize,
-        start: [f64; 2],
-        rolls: [[f64; 2]; 2],
+        start: Pose2,
+        rolls: Vec<Roll>,
         mut roll: usize,
         elapsed: f64,
         mut rolling: bool,
@@ -296,35 +492,34 @@ impl StepExecutor {
         let Some(legs) = self.legs_for(&p, obs.time) else { return self.hold() };
         let c: &ExecutorConfig = &self.config;
         let out_of_time = elapsed >= c.max_slide_s;
-        let remaining = |roll: usize| {
-            let (t0, t1) = if roll == 0 {
-                (rolls[0][0], rolls[0][1])
-            } else {
-                (rolls[0][0] + rolls[1][0], rolls[0][1] + rolls[1][1])
-            };
-            [t0 - (obs.base.x - start[0]), t1 - (obs.base.y - start[1])]
+        let feet = pairs_in_base(&self.robot, &p);
+        let reach = feet.iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
+        // The base pose at the end of roll `k`.
+        let target = |k: usize| rolls[..=k].iter().fold(start, |b, r| r.apply_pose(b));
+        let done = |k: usize| {
+            let t = target(k);
+            (t.x - obs.base.x).hypot(t.y - obs.base.y) < SLIDE_DONE_M
+                && wrap_angle(t.theta - obs.base.theta).abs() * reach < SLIDE_DONE_M
         };
-        let done = |r: [f64; 2]| r[0].hypot(r[1]) < SLIDE_DONE_M;
-        if rolling && roll == 0 && done(remaining(0)) && rolls[1] != [0.0; 2] {
-            roll = 1;
+        while rolling && roll + 1 < rolls.len() && done(roll) {
+            roll += 1;
         }
-        if rolling && (done(remaining(roll)) || out_of_time) {
+        if rolling && (done(roll) || out_of_time) {
             rolling = false;
         }
-        let next = |elapsed| Mode::Slide { index, start, rolls, roll, elapsed, rolling };
         if !rolling {
             let straight = obs.steering.iter().all(|s| s.abs() <= STRAIGHT_RAD);
             if straight || elapsed >= c.max_slide_s + STRAIGHTEN_S {
                 self.proceed(index);
             } else {
-                self.mode = next(elapsed + dt);
+                self.mode =
+                    Mode::Slide { index, start, rolls, roll, elapsed: elapsed + dt, rolling };
             }
             return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
         }
-        let twist = slide_twist(remaining(roll), obs.base.theta, c.slide_speed_mps);
-        let feet = pairs_in_base(&self.robot, &p);
+        let twist = slide_twist(obs.base, target(roll), reach, c.slide_speed_mps);
         let wheels = c.wheels.commands(&self.robot, twist, &feet, &obs.steering);
-        self.mode = next(elapsed + dt);
+        self.mode = Mode::Slide { index, start, rolls, roll, elapsed: elapsed + dt, rolling };
         Command { legs, wheels: self.with_steer_rate(wheels, obs) }
     }
 }
@@ -362,22 +557,40 @@ mod tests {
         (ex, o)
     }
 
+    /// The stance error of a stance shifted by `offset` and not turned (the standing
+    /// feet's centroid is the origin).
+    fn shifted(offset: [f64; 2]) -> StanceError {
+        StanceError { centre: [0.0; 2], offset, yaw: 0.0, worst_m: offset[0].hypot(offset[1]) }
+    }
+
     #[test]
-    fn the_stance_offset_is_the_mean_of_the_wheel_midpoints_less_the_feet() {
+    fn the_stance_error_fits_a_shift_and_a_turn_to_the_wheel_midpoints() {
         let r = robot();
         let p = standing();
-        let c = two_wheel_contacts(&p, [0.01, -0.03]);
-        let o = stance_offset(&r, &p, &c).unwrap();
-        assert!((o[0] - 0.01).abs() < 1e-12 && (o[1] + 0.03).abs() < 1e-12, "{o:?}");
-        // Front-left 4 cm further ahead than the others: the mean moves by 1 cm.
-        let mut c = c;
+        let near = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        // Shifted by (0.01, −0.03): every foot √(0.01² + 0.03²) = 0.031623 m off.
+        let e = stance_error(&r, &p, &two_wheel_contacts(&p, [0.01, -0.03])).unwrap();
+        assert!(near(e.offset[0], 0.01) && near(e.offset[1], -0.03) && near(e.yaw, 0.0), "{e:?}");
+        assert!(near(e.centre[0], 0.0) && near(e.centre[1], 0.0));
+        assert!((e.worst_m - 0.031623).abs() < 1e-6, "{e:?}");
+        // Turned by 0.02 rad about the centroid (the origin) and shifted 1 cm along y:
+        // the feet at 0.4749 m from it move 0.4749 · 0.02 = 9.5 mm around it.
+        let turn = Roll { centre: [0.0; 2], turn: 0.02, shift: [0.0, 0.01] };
+        let e = stance_error(&r, &p, &two_wheel_contacts(&rolled(&p, &turn), [0.0; 2])).unwrap();
+        assert!(near(e.yaw, 0.02) && near(e.offset[0], 0.0) && near(e.offset[1], 0.01), "{e:?}");
+        // Front-left 4 cm further ahead than the others: the centroid moves 1 cm, and the
+        // turn that fits best is atan2(Σ a × b, Σ a · b) over the feet about their
+        // centroids: Σ a × b = −(0.32 · 0.03 + 3 · 0.32 · 0.01) = −0.0128 and
+        // Σ a · b = 4 · (0.35² + 0.32²) + 0.35 · 0.03 + 0.35 · 0.01 = 0.9136: −0.014010 rad.
+        let mut c = two_wheel_contacts(&p, [0.0; 2]);
         for (l, q) in c.iter_mut() {
             if *l == Leg::FrontLeft {
                 q[0] += 0.04;
             }
         }
-        let o = stance_offset(&r, &p, &c).unwrap();
-        assert!((o[0] - 0.02).abs() < 1e-12 && (o[1] + 0.03).abs() < 1e-12, "{o:?}");
+        let e = stance_error(&r, &p, &c).unwrap();
+        assert!(near(e.offset[0], 0.01) && near(e.offset[1], 0.0), "{e:?}");
+        assert!((e.yaw + 0.014010).abs() < 1e-6 && near(e.worst_m, 0.04), "{e:?}");
     }
 
     #[test]
@@ -395,11 +608,13 @@ mod tests {
                 q[0] += 0.3;
             }
         }
-        let o = stance_offset(&r, &p, &c).unwrap();
-        assert!((o[0] - 0.02).abs() < 1e-12 && o[1].abs() < 1e-12, "{o:?}");
+        // Two legs measured: their shift, and no turn (one wheel's bounce would make one).
+        let e = stance_error(&r, &p, &c).unwrap();
+        assert!((e.offset[0] - 0.02).abs() < 1e-12 && e.offset[1].abs() < 1e-12, "{e:?}");
+        assert_eq!(e.yaw, 0.0);
         // Only front-right left: one leg is not a measurement.
         let c: Vec<_> = c.into_iter().filter(|(l, _)| *l != Leg::FrontLeft).collect();
-        assert_eq!(stance_offset(&r, &p, &c), None);
+        assert_eq!(stance_error(&r, &p, &c), None);
         // Contacts 0.3 m apart are not one pair's two wheels.
         let far: Vec<_> = Leg::ALL
             .iter()
@@ -408,18 +623,26 @@ mod tests {
                 [(l, [f[0], f[1] - 0.15]), (l, [f[0], f[1] + 0.15])]
             })
             .collect();
-        assert_eq!(stance_offset(&r, &standing(), &far), None);
+        assert_eq!(stance_error(&r, &standing(), &far), None);
     }
 
     #[test]
-    fn the_slide_twist_points_at_the_remaining_offset_in_the_robot_frame() {
+    fn the_slide_twist_points_at_the_remaining_pose_in_the_robot_frame() {
+        use std::f64::consts::FRAC_PI_2;
+        let at = Pose2::new(0.0, 0.0, FRAC_PI_2);
         // 1 cm left in the world at heading 90°: the robot's −x' (it rolls backward),
         // at 2/s · 0.01 m = 0.02 m/s; 10 cm left: capped at 0.03 m/s.
-        let t = slide_twist([-0.01, 0.0], std::f64::consts::FRAC_PI_2, 0.03);
-        assert!((t.vx + 0.0).abs() < 1e-12 && (t.vy - 0.02).abs() < 1e-12, "{t:?}");
-        let t = slide_twist([0.0, 0.1], 0.0, 0.03);
+        let t = slide_twist(at, Pose2::new(-0.01, 0.0, FRAC_PI_2), 0.5, 0.03);
+        assert!(t.vx.abs() < 1e-12 && (t.vy - 0.02).abs() < 1e-12 && t.wz == 0.0, "{t:?}");
+        let t = slide_twist(Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.0, 0.1, 0.0), 0.5, 0.03);
         assert!(t.vx.abs() < 1e-12 && (t.vy - 0.03).abs() < 1e-12, "{t:?}");
-        assert_eq!(slide_twist([0.0, 0.0], 1.0, 0.03), Twist::default());
+        // A turn of 0.01 rad left: 0.02 rad/s (the farthest pair, 0.5 m out, at 1 cm/s);
+        // of 0.1 rad: the pair would go at 0.1 m/s, so all is scaled to 0.03: 0.06 rad/s.
+        let t = slide_twist(at, Pose2::new(0.0, 0.0, FRAC_PI_2 + 0.01), 0.5, 0.03);
+        assert!(t.vx.abs() < 1e-12 && t.vy.abs() < 1e-12 && (t.wz - 0.02).abs() < 1e-12);
+        let t = slide_twist(at, Pose2::new(0.0, 0.0, FRAC_PI_2 + 0.1), 0.5, 0.03);
+        assert!((t.wz - 0.06).abs() < 1e-12, "{t:?}");
+        assert_eq!(slide_twist(at, at, 0.5, 0.03), Twist::default());
     }
 
     #[test]
@@ -432,7 +655,7 @@ mod tests {
         assert!(
             ex.events
                 .iter()
-                .any(|e| matches!(e.event, ExecEventKind::Slide { offset_m, slid_m, rolls: 1 } if (offset_m - 0.03).abs() < 1e-9 && (slid_m - 0.03).abs() < 1e-9))
+                .any(|e| matches!(e.event, ExecEventKind::Slide { offset_m, slid_m, rolls: 1, turned_rad, .. } if (offset_m - 0.03).abs() < 1e-9 && (slid_m - 0.03).abs() < 1e-9 && turned_rad.abs() < 1e-12))
         );
         let legs_before = ex.last_legs;
         let (cmd, _) = ex.tick(&o, 0.01);
@@ -469,18 +692,26 @@ mod tests {
         // puts a wheel 0.06 · sin 20° = 2 cm forward, against it (a sphere of 8 cm).
         let ex = StepExecutor::new(&robot(), config(), step_path(), riser_from(0.45));
         // 3 cm to the left: only a sideways roll takes it out: no slide.
-        assert_eq!(ex.slide_rolls([0.0, 0.03]), None);
+        assert_eq!(shifts(&ex, [0.0, 0.03]), None);
         // 3 cm behind and 3 cm to the left: the 3 cm along the heading.
-        let r = ex.slide_rolls([-0.03, 0.03]).unwrap();
-        assert!(close(r[0], [0.03, 0.0]) && r[1] == [0.0; 2], "{r:?}");
+        let r = shifts(&ex, [-0.03, 0.03]).unwrap();
+        assert!(r.len() == 1 && close(r[0], [0.03, 0.0]), "{r:?}");
         // 2 cm behind and 3 cm to the left: the 2 cm along are within a cell: no slide.
-        assert_eq!(ex.slide_rolls([-0.02, 0.03]), None);
+        assert_eq!(shifts(&ex, [-0.02, 0.03]), None);
         // On open ground the whole offset in one roll.
         let ex = StepExecutor::new(&robot(), config(), step_path(), ground());
-        let r = ex.slide_rolls([-0.02, 0.03]).unwrap();
-        assert!(close(r[0], [0.02, -0.03]) && r[1] == [0.0; 2], "{r:?}");
+        let r = shifts(&ex, [-0.02, 0.03]).unwrap();
+        assert!(r.len() == 1 && close(r[0], [0.02, -0.03]), "{r:?}");
         // Within a cell (2.5 cm) nothing.
-        assert_eq!(ex.slide_rolls([0.02, 0.01]), None);
+        assert_eq!(shifts(&ex, [0.02, 0.01]), None);
+    }
+
+    /// The shifts of the rolls a slide makes for a stance shifted by `offset`, none of
+    /// which turns.
+    fn shifts(ex: &StepExecutor, offset: [f64; 2]) -> Option<Vec<[f64; 2]>> {
+        let rolls = ex.slide_rolls(&shifted(offset))?;
+        assert!(rolls.iter().all(|r| r.turn == 0.0), "{rolls:?}");
+        Some(rolls.iter().map(|r| r.shift).collect())
     }
 
     #[test]
@@ -492,8 +723,71 @@ mod tests {
         // first (forward first carries the wheel 1.5 cm nearer the riser):
         // (−0.015, +0.015), then (+0.015, +0.015).
         let ex = StepExecutor::new(&robot(), config(), step_path(), riser_from(0.475));
-        let r = ex.slide_rolls([0.0, -0.03]).unwrap();
-        assert!(close(r[0], [-0.015, 0.015]) && close(r[1], [0.015, 0.015]), "{r:?}");
+        let r = shifts(&ex, [0.0, -0.03]).unwrap();
+        assert!(r.len() == 2 && close(r[0], [-0.015, 0.015]) && close(r[1], [0.015, 0.015]));
+    }
+
+    /// The stance of [`standing`] turned by `yaw` (rad) about its centre (the origin),
+    /// measured on every wheel.
+    fn turned_contacts(yaw: f64) -> Vec<(Leg, [f64; 2])> {
+        let turn = Roll { centre: [0.0; 2], turn: yaw, shift: [0.0; 2] };
+        two_wheel_contacts(&rolled(&standing(), &turn), [0.0; 2])
+    }
+
+    #[test]
+    fn a_turned_stance_is_turned_back_on_the_spot_on_open_ground() {
+        // Turned 0.06 rad: the feet, 0.4749 m from the centre, stand 2.85 cm from their
+        // footholds (more than a cell). On open ground one roll turns it back, every pair
+        // steered across its radius: front-left at (0.35, 0.32) moves along
+        // (0.32, −0.35) for a turn to the right, −47.6° from the heading.
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
+        let mut o = obs(0.0, &ex, &turned_contacts(0.06), [0.0; 3]);
+        o.base.theta = 0.06;
+        ex.check_stance(1, &o);
+        let Mode::Slide { ref rolls, .. } = ex.mode else { panic!("{:?}", ex.mode) };
+        assert_eq!(rolls.len(), 1);
+        assert!((rolls[0].turn + 0.06).abs() < 1e-9 && close(rolls[0].shift, [0.0; 2]));
+        assert!(ex.events.iter().any(|e| matches!(e.event,
+            ExecEventKind::Slide { yaw_rad, turned_rad, rolls: 1, .. }
+                if (yaw_rad - 0.06).abs() < 1e-9 && (turned_rad + 0.06).abs() < 1e-9)));
+        o.steering = [0.0; 4];
+        let (cmd, _) = ex.tick(&o, 0.01);
+        let fl = cmd.wheels[Leg::FrontLeft.index()].steer;
+        assert!((fl - (-0.35f64).atan2(0.32)).abs() < 0.01, "{fl}");
+        // Turned back: the pairs (still at −47.6°) steer straight, then the guard.
+        o.base.theta = 0.0;
+        o.steering = [-0.83; 4];
+        let (cmd, _) = ex.tick(&o, 0.01);
+        assert!(matches!(ex.mode, Mode::Slide { rolling: false, .. }), "{:?}", ex.mode);
+        assert!(cmd.wheels.iter().all(|w| w.steer == 0.0), "{:?}", cmd.wheels);
+        o.steering = [0.0; 4];
+        ex.tick(&o, 0.01);
+        assert!(matches!(ex.mode, Mode::Guard { index: 1, .. }), "{:?}", ex.mode);
+    }
+
+    #[test]
+    fn near_a_riser_a_turn_goes_in_two_arcs_like_a_three_point_turn() {
+        // The riser 0.12 m ahead of the front feet (x = 0.47 m): a front pair steered
+        // 47.6° to turn on the spot reaches 0.35 + 0.08 + 0.06 · sin 47.6° = 0.474 m,
+        // against it; on arcs of a larger radius the pairs steer less.
+        let ex = StepExecutor::new(&robot(), config(), step_path(), riser_from(0.47));
+        let err = stance_error(&robot(), &standing(), &turned_contacts(0.06)).unwrap();
+        let now = rolled(&standing(), &err.forward());
+        let on_the_spot = Roll { shift: [0.0; 2], ..err.back() };
+        assert!(!ex.rolls_keep_the_ground(&now, &[on_the_spot]));
+        let rolls = ex.slide_rolls(&err).unwrap();
+        assert_eq!(rolls.len(), 2, "{rolls:?}");
+        // Each arc half the turn, about centres on either side of the stance, at least
+        // the smallest radius away, the same distance.
+        let d: Vec<f64> = rolls.iter().map(|r| r.centre[0].hypot(r.centre[1])).collect();
+        for r in &rolls {
+            assert!((r.turn + 0.03).abs() < 1e-9 && r.shift == [0.0; 2], "{r:?}");
+        }
+        assert!(d[0] >= TURN_ARC_RADII[0] - 1e-9 && (d[0] - d[1]).abs() < 0.02, "{d:?}");
+        assert!(rolls[0].centre[1] * rolls[1].centre[1] < 0.0, "{rolls:?}");
+        // Together: turned back, the stance's centre where it was within a few mm.
+        let end = rolls.iter().fold(Pose2::new(0.0, 0.0, 0.06), |b, r| r.apply_pose(b));
+        assert!(end.theta.abs() < 1e-9 && end.x.hypot(end.y) < 0.005, "{end:?}");
     }
 
     #[test]
@@ -571,7 +865,9 @@ mod tests {
             .events
             .iter()
             .filter_map(|e| match e.event {
-                ExecEventKind::SlideRefused { offset_m, lateral_m } => Some((offset_m, lateral_m)),
+                ExecEventKind::SlideRefused { offset_m, lateral_m, .. } => {
+                    Some((offset_m, lateral_m))
+                }
                 _ => None,
             })
             .collect();
