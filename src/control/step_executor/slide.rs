@@ -291,10 +291,10 @@ impl StepExecutor {
 
     /// The rolls a stance slide makes for the stance error `err`, each checked with
     /// [`Self::steering_keeps_the_ground`] from where it starts: all of the error back in
-    /// one roll (turn and shift) if the pairs can steer to it; else the turn alone about
-    /// the stance's centre where it moves a foot by more than [`SLIDE_DONE_M`] and the
-    /// pairs can steer to it, then the shift as [`Self::shift_rolls`] finds it; else the
-    /// shift alone. `None` if no foot stands more than the threshold from its foothold,
+    /// one roll (turn and shift) if the pairs can steer to it; else, where the turn moves
+    /// a foot by more than [`SLIDE_DONE_M`], the turn as [`Self::turn_rolls`] finds it (on
+    /// the spot or in two arcs), then the shift as [`Self::shift_rolls`] finds it; else
+    /// the shift alone. `None` if no foot stands more than the threshold from its foothold,
     /// or nothing can be rolled.
     fn slide_rolls(&self, err: &StanceError) -> Option<Vec<Roll>> {
         if err.worst_m <= self.config.slide_threshold_m {
@@ -336,21 +336,20 @@ impl StepExecutor {
             return vec![on_the_spot];
         }
         let half = 0.5 * turn;
+        // The unit vectors to the robot's left before the turn and half way through it.
+        let left = |yaw: f64| [-yaw.sin(), yaw.cos()];
+        let (n, n1) = (left(from.base_rpy[2]), left(from.base_rpy[2] + half));
         for radius in TURN_ARC_RADII {
             for side in [1.0, -1.0] {
                 // The first arc's centre `radius` to the left (side 1) or right of the
                 // stance centre; the second's as far to the other side of where the first
                 // leaves it.
-                let left = |yaw: f64| [-yaw.sin(), yaw.cos()];
-                let yaw = from.base_rpy[2];
-                let n = left(yaw);
                 let first = Roll {
                     centre: [centre[0] + side * radius * n[0], centre[1] + side * radius * n[1]],
                     turn: half,
                     shift: [0.0; 2],
                 };
                 let c1 = first.apply(centre);
-                let n1 = left(yaw + half);
                 let second = Roll {
                     centre: [c1[0] - side * radius * n1[0], c1[1] - side * radius * n1[1]],
                     turn: half,
