@@ -666,6 +666,55 @@ impl<'a> Expander<'a> {
         Ok(Alignment { height, stance, d, wanted, moved, roll, rest })
     }
 
+    /// The base shift of a step candidate, m (Fig. 12b): the longitudinal remainder of
+    /// its alignment, only where the partner wheel could not go as far as alignment
+    /// wanted (blocked, or a candidate with a shorter wheel move).
+    fn candidate_shift(&self, aligned: &Alignment, shift: Shift) -> f64 {
+        let max_shift = self.o.max_base_shift_m;
+        let hindered = aligned.d + 1e-3 < aligned.wanted;
+        match shift {
+            Shift::Remainder(fraction) => {
+                if hindered && aligned.rest.abs() > 0.02 {
+                    fraction * aligned.rest.clamp(-max_shift, max_shift)
+                } else {
+                    0.0
+                }
+            }
+            Shift::Fixed(m) => m.clamp(-max_shift, max_shift),
+        }
+    }
+
+    /// A step candidate's lift keyframe (the foot raised to `swing_z` over where it
+    /// stood, the base rolled and shifted by `shift` m) and the shifted base's x, y.
+    fn lift_keyframe(
+        &self,
+        leg: Leg,
+        swing_z: f64,
+        aligned: &Alignment,
+        shift: f64,
+    ) -> (Posture, [f64; 2]) {
+        let i = leg.index();
+        let (yaw, xy, pre) = (self.cur.base_rpy[2], self.xy(), self.cur.feet);
+        let (s, c) = yaw.sin_cos();
+        let xy_shift = [xy[0] + shift * c, xy[1] + shift * s];
+        let mut lift_feet = aligned.moved;
+        lift_feet[i] = [pre[i][0], pre[i][1], swing_z];
+        let mut lifted = [true; 4];
+        lifted[i] = false;
+        let StepStance { pitch, ground, .. } = aligned.stance;
+        let p = self.standing(
+            lift_feet,
+            lifted,
+            xy_shift,
+            yaw,
+            pitch,
+            aligned.roll,
+            aligned.height,
+            ground,
+        );
+        (p, xy_shift)
+    }
+
     /// Builds the keyframes of one step candidate from its alignment, the foot carried
     /// at `swing_z`.
     fn step_candidate(
@@ -675,38 +724,19 @@ impl<'a> Expander<'a> {
         aligned: &Alignment,
         shift: Shift,
     ) -> Vec<Planned> {
-        let Alignment { height, stance, d, wanted, moved, roll, rest } = *aligned;
+        let Alignment { height, stance, d, moved, roll, .. } = *aligned;
         let StepStance { post, pitch, ground } = stance;
         let (i, j) = (leg.index(), leg.same_side_partner().index());
         let post_foot = post[i];
         let yaw = self.cur.base_rpy[2];
         let pitch_post = self.pitch_for(&post, yaw);
-        let (s, c) = yaw.sin_cos();
-        let max_shift = self.o.max_base_shift_m;
         let pre = self.cur.feet;
         let xy = self.xy();
         let all = [true; 4];
         let mut lifted = all;
         lifted[i] = false;
-
-        // Longitudinal remainder: base shift (Fig. 12b).
-        // Only when the wheel could not go as far as alignment wanted (blocked, or a
-        // candidate with a shorter wheel move).
-        let hindered = d + 1e-3 < wanted;
-        let shift = match shift {
-            Shift::Remainder(fraction) => {
-                if hindered && rest.abs() > 0.02 {
-                    fraction * rest.clamp(-max_shift, max_shift)
-                } else {
-                    0.0
-                }
-            }
-            Shift::Fixed(m) => m.clamp(-max_shift, max_shift),
-        };
-        let xy_shift = [xy[0] + shift * c, xy[1] + shift * s];
-
-        let mut lift_feet = moved;
-        lift_feet[i] = [pre[i][0], pre[i][1], swing_z];
+        let shift = self.candidate_shift(aligned, shift);
+        let (lift, xy_shift) = self.lift_keyframe(leg, swing_z, aligned, shift);
         let mut swing_feet = moved;
         swing_feet[i] = [post_foot[0], post_foot[1], swing_z];
         let mut placed = moved;
@@ -723,7 +753,7 @@ impl<'a> Expander<'a> {
         if shift != 0.0 {
             seq.push((Phase::BaseShift, None, st(moved, all, xy_shift, roll, pitch)));
         }
-        seq.push((Phase::Lift, Some(leg), st(lift_feet, lifted, xy_shift, roll, pitch)));
+        seq.push((Phase::Lift, Some(leg), lift));
         seq.push((Phase::Swing, Some(leg), st(swing_feet, lifted, xy_shift, roll, pitch)));
         seq.push((Phase::Place, Some(leg), st(placed, all, xy_shift, roll, pitch)));
         if shift != 0.0 {
@@ -781,8 +811,10 @@ impl<'a> Expander<'a> {
         // The same for every candidate (what `step_heights` checked the swing at).
         let swing_z =
             rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot, self.cur.base_rpy[2]);
-        let mut best: (f64, f64, String) =
-            (f64::NEG_INFINITY, self.o.min_margin_m, "no candidate".to_owned());
+        // The best failure so far (the largest margin short of the requirement), put
+        // into words only if the step fails: most candidates the planner asks about do.
+        let mut best: (f64, f64, Option<Result<SegmentFailure, String>>) =
+            (f64::NEG_INFINITY, self.o.min_margin_m, None);
         let candidates: Box<dyn Iterator<Item = (f64, f64, f64, Shift)>> = match search {
             StepSearch::Planner => {
                 Box::new(heights.flat_map(|h| {
@@ -796,6 +828,18 @@ impl<'a> Expander<'a> {
         // are checked once.
         let mut alignments: Vec<(AlignmentKey, Result<Alignment, String>)> = Vec::new();
         let mut tried: Vec<Vec<Planned>> = Vec::new();
+        let mut failed_lifts: Vec<Posture> = Vec::new();
+        let min_margin = self.o.min_margin_m;
+        let note = |best: &mut (f64, f64, Option<Result<SegmentFailure, String>>),
+                    f: SegmentFailure| {
+            let (m, r) = match f.cause {
+                Infeasible::Margin { margin_m, required_m } => (margin_m, required_m),
+                _ => (f64::NEG_INFINITY, min_margin),
+            };
+            if m > best.0 || best.0 == f64::NEG_INFINITY {
+                *best = (m, r, Some(Ok(f)));
+            }
+        };
         for (h, wf, rf, shift) in candidates {
             let key = (h, wf, rf);
             let aligned = match alignments.iter().find(|(k, _)| *k == key) {
@@ -810,11 +854,28 @@ impl<'a> Expander<'a> {
                 Ok(a) => a,
                 Err(e) => {
                     if best.0 == f64::NEG_INFINITY {
-                        best.2 = e;
+                        best.2 = Some(Err(e));
                     }
                     continue;
                 }
             };
+            // The lift keyframe first: most candidates that fail, fail there (the CoM
+            // over the support triangle of three feet), and it is one posture where the
+            // whole sequence is up to nine and their segments. The verdict is the
+            // same: the trial checks every keyframe.
+            let (lift, _) =
+                self.lift_keyframe(leg, swing_z, &aligned, self.candidate_shift(&aligned, shift));
+            if failed_lifts.contains(&lift) {
+                continue;
+            }
+            if let Err(cause) = self.check_posture(&lift) {
+                note(
+                    &mut best,
+                    SegmentFailure { phase: Phase::Lift.name(), percent: 100.0, cause },
+                );
+                failed_lifts.push(lift);
+                continue;
+            }
             let seq = self.step_candidate(leg, swing_z, &aligned, shift);
             if tried.contains(&seq) {
                 continue;
@@ -824,15 +885,7 @@ impl<'a> Expander<'a> {
                     self.commit(k, mm, m3, s);
                     return Ok(());
                 }
-                Err(f) => {
-                    let (m, r) = match f.cause {
-                        Infeasible::Margin { margin_m, required_m } => (margin_m, required_m),
-                        _ => (f64::NEG_INFINITY, self.o.min_margin_m),
-                    };
-                    if m > best.0 || best.0 == f64::NEG_INFINITY {
-                        best = (m, r, f.to_string());
-                    }
-                }
+                Err(f) => note(&mut best, f),
             }
             tried.push(seq);
         }
@@ -841,7 +894,11 @@ impl<'a> Expander<'a> {
             leg,
             best_margin_m: best.0,
             required_m: best.1,
-            reason: best.2,
+            reason: match best.2 {
+                Some(Ok(f)) => f.to_string(),
+                Some(Err(e)) => e,
+                None => "no candidate".to_owned(),
+            },
         })
     }
 

@@ -12,7 +12,7 @@ use super::CenterOfMassModel;
 use crate::geometry::{Pose2, norm2};
 use crate::robot::ik::{IkError, LegChain, leg_chain, leg_ik, world_down};
 use crate::robot::{Leg, RobotDescription};
-use crate::stability::{convex_hull, stability_margin};
+use crate::stability::{stability_margin, with_hull};
 use serde::Serialize;
 
 /// Largest lateral offset of a contact point from its hip's sagittal plane accepted for a
@@ -110,12 +110,16 @@ pub struct Evaluation {
 
 /// Vertex mean of the convex hull of `points` (the triangle centroid for three points).
 pub fn support_centroid(points: &[[f64; 2]]) -> Option<[f64; 2]> {
-    let hull = convex_hull(points);
-    if hull.is_empty() {
-        return None;
-    }
-    let n = hull.len() as f64;
-    Some([hull.iter().map(|p| p[0]).sum::<f64>() / n, hull.iter().map(|p| p[1]).sum::<f64>() / n])
+    with_hull(points, |hull| {
+        if hull.is_empty() {
+            return None;
+        }
+        let n = hull.len() as f64;
+        Some([
+            hull.iter().map(|p| p[0]).sum::<f64>() / n,
+            hull.iter().map(|p| p[1]).sum::<f64>() / n,
+        ])
+    })
 }
 
 /// The trigonometry of a base orientation, computed once for every check of a posture

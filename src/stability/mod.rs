@@ -8,35 +8,72 @@
 
 use crate::geometry::norm2;
 
+/// Most points whose hull [`with_hull`] computes on the stack: a robot's contacts (four
+/// wheel pairs), which the planner's checks evaluate millions of times.
+const STACK_POINTS: usize = 8;
+
 /// Convex hull of points in the plane, counter-clockwise, without collinear points
 /// (Andrew's monotone chain). Deterministic for equal inputs.
 pub fn convex_hull(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
-    let mut p: Vec<[f64; 2]> =
-        points.iter().copied().filter(|q| q[0].is_finite() && q[1].is_finite()).collect();
-    p.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
-    p.dedup();
-    if p.len() < 3 {
-        return p;
+    with_hull(points, <[[f64; 2]]>::to_vec)
+}
+
+/// `f` of the [`convex_hull`] of `points`, the hull kept on the stack for up to
+/// [`STACK_POINTS`] points.
+pub fn with_hull<R>(points: &[[f64; 2]], f: impl FnOnce(&[[f64; 2]]) -> R) -> R {
+    if points.len() <= STACK_POINTS {
+        let mut sorted = [[0.0; 2]; STACK_POINTS];
+        let mut hull = [[0.0; 2]; 2 * STACK_POINTS];
+        let n = hull_into(points, &mut sorted, &mut hull);
+        f(&hull[..n])
+    } else {
+        let mut sorted = vec![[0.0; 2]; points.len()];
+        let mut hull = vec![[0.0; 2]; 2 * points.len()];
+        let n = hull_into(points, &mut sorted, &mut hull);
+        f(&hull[..n])
+    }
+}
+
+/// The monotone chain over the finite `points`, sorted and deduplicated into `sorted`
+/// (room for all of them), the hull written to `hull` (room for twice as many); returns
+/// the hull's length.
+fn hull_into(points: &[[f64; 2]], sorted: &mut [[f64; 2]], hull: &mut [[f64; 2]]) -> usize {
+    let mut m = 0;
+    for q in points.iter().filter(|q| q[0].is_finite() && q[1].is_finite()) {
+        sorted[m] = *q;
+        m += 1;
+    }
+    let p = &mut sorted[..m];
+    p.sort_unstable_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    // Equal neighbours (by `==`, as `Vec::dedup`) once.
+    let mut k = 0;
+    for i in 0..m {
+        if k == 0 || p[i] != p[k - 1] {
+            p[k] = p[i];
+            k += 1;
+        }
+    }
+    if k < 3 {
+        hull[..k].copy_from_slice(&p[..k]);
+        return k;
     }
     let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
         (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
     };
-    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(p.len() * 2);
+    let mut len = 0;
     for pass in 0..2 {
-        let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &[f64; 2]>> =
-            if pass == 0 { Box::new(p.iter()) } else { Box::new(p.iter().rev()) };
-        for &q in iter {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 1e-12
-            {
-                hull.pop();
+        let start = len;
+        for idx in 0..k {
+            let q = if pass == 0 { p[idx] } else { p[k - 1 - idx] };
+            while len >= start + 2 && cross(hull[len - 2], hull[len - 1], q) <= 1e-12 {
+                len -= 1;
             }
-            hull.push(q);
+            hull[len] = q;
+            len += 1;
         }
-        hull.pop();
+        len -= 1;
     }
-    hull
+    len
 }
 
 /// Distance from `p` to the segment from `a` to `b` in the plane.
@@ -54,7 +91,11 @@ pub fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 /// Signed distance of `com` (horizontal projection) to the boundary of the convex hull of
 /// `contacts`: positive inside. `-inf` without contacts.
 pub fn stability_margin(contacts: &[[f64; 2]], com: [f64; 2]) -> f64 {
-    let hull = convex_hull(contacts);
+    with_hull(contacts, |hull| margin_in(hull, com))
+}
+
+/// [`stability_margin`] of `com` in the hull `hull`.
+fn margin_in(hull: &[[f64; 2]], com: [f64; 2]) -> f64 {
     match hull.len() {
         0 => f64::NEG_INFINITY,
         1 => -norm2(com[0] - hull[0][0], com[1] - hull[0][1]),
@@ -95,6 +136,40 @@ mod tests {
         let tri = [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]];
         assert!((stability_margin(&tri, [0.5, 0.5]) - 0.5).abs() < 1e-12);
         assert!((stability_margin(&tri, [0.9, 0.9]) - 0.2 / 2f64.sqrt()).abs() < 1e-12);
+    }
+
+    proptest::proptest! {
+        /// The hull on the stack (up to 8 points) and on the heap (more) is the convex
+        /// hull: counter-clockwise, no collinear vertex, every point on or left of every
+        /// edge, every vertex one of the points; and a point set's hull does not depend
+        /// on which path computed it (the first 8 points again, padded with copies of
+        /// them past the stack's size).
+        #[test]
+        fn the_hull_holds_every_point_on_either_path(
+            pts in proptest::collection::vec((-2i32..=2, -2i32..=2), 1..14)
+        ) {
+            let pts: Vec<[f64; 2]> =
+                pts.iter().map(|&(x, y)| [f64::from(x) * 0.3, f64::from(y) * 0.2]).collect();
+            let hull = convex_hull(&pts);
+            let n = hull.len();
+            for v in &hull {
+                proptest::prop_assert!(pts.contains(v));
+            }
+            if n >= 3 {
+                for i in 0..n {
+                    let (a, b, c) = (hull[i], hull[(i + 1) % n], hull[(i + 2) % n]);
+                    let turn = (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]);
+                    proptest::prop_assert!(turn > 0.0, "{hull:?}");
+                    for p in &pts {
+                        let side = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+                        proptest::prop_assert!(side >= -1e-12, "{p:?} right of {a:?}→{b:?}");
+                    }
+                }
+            }
+            let first: Vec<[f64; 2]> = pts.iter().copied().take(8).collect();
+            let padded: Vec<[f64; 2]> = first.iter().cycle().copied().take(12).collect();
+            proptest::prop_assert_eq!(convex_hull(&first), convex_hull(&padded));
+        }
     }
 
     #[test]
