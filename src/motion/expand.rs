@@ -715,6 +715,15 @@ impl<'a> Expander<'a> {
         (p, xy_shift)
     }
 
+    /// A step candidate's stance after its base shift to `xy_shift`: all feet down, the
+    /// partner wheel moved, the base rolled.
+    fn shifted_stance(&self, aligned: &Alignment, xy_shift: [f64; 2]) -> Posture {
+        let StepStance { pitch, ground, .. } = aligned.stance;
+        let yaw = self.cur.base_rpy[2];
+        let (moved, roll, height) = (aligned.moved, aligned.roll, aligned.height);
+        self.standing(moved, [true; 4], xy_shift, yaw, pitch, roll, height, ground)
+    }
+
     /// Builds the keyframes of one step candidate from its alignment, the foot carried
     /// at `swing_z`.
     fn step_candidate(
@@ -751,7 +760,7 @@ impl<'a> Expander<'a> {
             seq.push((Phase::WheelToCentre, Some(Leg::ALL[j]), st(moved, all, xy, roll, pitch)));
         }
         if shift != 0.0 {
-            seq.push((Phase::BaseShift, None, st(moved, all, xy_shift, roll, pitch)));
+            seq.push((Phase::BaseShift, None, self.shifted_stance(aligned, xy_shift)));
         }
         seq.push((Phase::Lift, Some(leg), lift));
         seq.push((Phase::Swing, Some(leg), st(swing_feet, lifted, xy_shift, roll, pitch)));
@@ -828,7 +837,8 @@ impl<'a> Expander<'a> {
         // are checked once.
         let mut alignments: Vec<(AlignmentKey, Result<Alignment, String>)> = Vec::new();
         let mut tried: Vec<Vec<Planned>> = Vec::new();
-        let mut failed_lifts: Vec<Posture> = Vec::new();
+        // Early keyframes that failed (candidates can share them).
+        let mut failed_early: Vec<Posture> = Vec::new();
         let min_margin = self.o.min_margin_m;
         let note = |best: &mut (f64, f64, Option<Result<SegmentFailure, String>>),
                     f: SegmentFailure| {
@@ -840,7 +850,7 @@ impl<'a> Expander<'a> {
                 *best = (m, r, Some(Ok(f)));
             }
         };
-        for (h, wf, rf, shift) in candidates {
+        'candidates: for (h, wf, rf, shift) in candidates {
             let key = (h, wf, rf);
             let aligned = match alignments.iter().find(|(k, _)| *k == key) {
                 Some((_, a)) => a.clone(),
@@ -859,22 +869,25 @@ impl<'a> Expander<'a> {
                     continue;
                 }
             };
-            // The lift keyframe first: most candidates that fail, fail there (the CoM
-            // over the support triangle of three feet), and it is one posture where the
-            // whole sequence is up to nine and their segments. The verdict is the
-            // same: the trial checks every keyframe.
-            let (lift, _) =
-                self.lift_keyframe(leg, swing_z, &aligned, self.candidate_shift(&aligned, shift));
-            if failed_lifts.contains(&lift) {
+            // The lift keyframe first, then the shifted stance where the base shifts:
+            // most candidates that fail, fail at one of them (the CoM over the support
+            // triangle of three feet; the stepping leg stretched by the shift), and each
+            // is one posture where the whole sequence is up to nine and their segments.
+            // The verdict is the same: the trial checks every keyframe.
+            let shift_m = self.candidate_shift(&aligned, shift);
+            let (lift, xy_shift) = self.lift_keyframe(leg, swing_z, &aligned, shift_m);
+            let shifted = (shift_m != 0.0).then(|| self.shifted_stance(&aligned, xy_shift));
+            let early = [Some((Phase::Lift, lift)), shifted.map(|p| (Phase::BaseShift, p))];
+            let early = early.iter().flatten();
+            if early.clone().any(|(_, p)| failed_early.contains(p)) {
                 continue;
             }
-            if let Err(cause) = self.check_posture(&lift) {
-                note(
-                    &mut best,
-                    SegmentFailure { phase: Phase::Lift.name(), percent: 100.0, cause },
-                );
-                failed_lifts.push(lift);
-                continue;
+            for &(phase, p) in early {
+                if let Err(cause) = self.check_posture(&p) {
+                    note(&mut best, SegmentFailure { phase: phase.name(), percent: 100.0, cause });
+                    failed_early.push(p);
+                    continue 'candidates;
+                }
             }
             let seq = self.step_candidate(leg, swing_z, &aligned, shift);
             if tried.contains(&seq) {
