@@ -666,13 +666,21 @@ impl<'a> Expander<'a> {
         Ok(Alignment { height, stance, d, wanted, moved, roll, rest })
     }
 
-    /// The base shift of a step candidate, m (Fig. 12b): the longitudinal remainder of
-    /// its alignment, only where the partner wheel could not go as far as alignment
-    /// wanted (blocked, or a candidate with a shorter wheel move).
-    fn candidate_shift(&self, aligned: &Alignment, shift: Shift) -> f64 {
+    /// A step candidate's early keyframes (see [`EarlyKeyframes`]): its base shift of
+    /// `shift` (Fig. 12b: the longitudinal remainder of its alignment, only where the
+    /// partner wheel could not go as far as alignment wanted, blocked or a candidate with
+    /// a shorter wheel move), the foot lifted to `swing_z` over where it stood, and the
+    /// stance after the shift.
+    fn early_keyframes(
+        &self,
+        leg: Leg,
+        swing_z: f64,
+        aligned: &Alignment,
+        shift: Shift,
+    ) -> EarlyKeyframes {
         let max_shift = self.o.max_base_shift_m;
         let hindered = aligned.d + 1e-3 < aligned.wanted;
-        match shift {
+        let shift = match shift {
             Shift::Remainder(fraction) => {
                 if hindered && aligned.rest.abs() > 0.02 {
                     fraction * aligned.rest.clamp(-max_shift, max_shift)
@@ -681,47 +689,26 @@ impl<'a> Expander<'a> {
                 }
             }
             Shift::Fixed(m) => m.clamp(-max_shift, max_shift),
-        }
-    }
-
-    /// A step candidate's lift keyframe (the foot raised to `swing_z` over where it
-    /// stood, the base rolled and shifted by `shift` m) and the shifted base's x, y.
-    fn lift_keyframe(
-        &self,
-        leg: Leg,
-        swing_z: f64,
-        aligned: &Alignment,
-        shift: f64,
-    ) -> (Posture, [f64; 2]) {
+        };
         let i = leg.index();
         let (yaw, xy, pre) = (self.cur.base_rpy[2], self.xy(), self.cur.feet);
         let (s, c) = yaw.sin_cos();
         let xy_shift = [xy[0] + shift * c, xy[1] + shift * s];
-        let mut lift_feet = aligned.moved;
+        let Alignment { height, stance, moved, roll, .. } = *aligned;
+        let StepStance { pitch, ground, .. } = stance;
+        let mut lift_feet = moved;
         lift_feet[i] = [pre[i][0], pre[i][1], swing_z];
         let mut lifted = [true; 4];
         lifted[i] = false;
-        let StepStance { pitch, ground, .. } = aligned.stance;
-        let p = self.standing(
-            lift_feet,
-            lifted,
+        let st = |feet, contact| {
+            self.standing(feet, contact, xy_shift, yaw, pitch, roll, height, ground)
+        };
+        EarlyKeyframes {
+            shift,
             xy_shift,
-            yaw,
-            pitch,
-            aligned.roll,
-            aligned.height,
-            ground,
-        );
-        (p, xy_shift)
-    }
-
-    /// A step candidate's stance after its base shift to `xy_shift`: all feet down, the
-    /// partner wheel moved, the base rolled.
-    fn shifted_stance(&self, aligned: &Alignment, xy_shift: [f64; 2]) -> Posture {
-        let StepStance { pitch, ground, .. } = aligned.stance;
-        let yaw = self.cur.base_rpy[2];
-        let (moved, roll, height) = (aligned.moved, aligned.roll, aligned.height);
-        self.standing(moved, [true; 4], xy_shift, yaw, pitch, roll, height, ground)
+            lift: st(lift_feet, lifted),
+            shifted: (shift != 0.0).then(|| st(moved, [true; 4])),
+        }
     }
 
     /// Builds the keyframes of one step candidate from its alignment, the foot carried
@@ -731,7 +718,7 @@ impl<'a> Expander<'a> {
         leg: Leg,
         swing_z: f64,
         aligned: &Alignment,
-        shift: Shift,
+        early: &EarlyKeyframes,
     ) -> Vec<Planned> {
         let Alignment { height, stance, d, moved, roll, .. } = *aligned;
         let StepStance { post, pitch, ground } = stance;
@@ -744,8 +731,7 @@ impl<'a> Expander<'a> {
         let all = [true; 4];
         let mut lifted = all;
         lifted[i] = false;
-        let shift = self.candidate_shift(aligned, shift);
-        let (lift, xy_shift) = self.lift_keyframe(leg, swing_z, aligned, shift);
+        let EarlyKeyframes { shift, xy_shift, lift, shifted } = *early;
         let mut swing_feet = moved;
         swing_feet[i] = [post_foot[0], post_foot[1], swing_z];
         let mut placed = moved;
@@ -759,8 +745,8 @@ impl<'a> Expander<'a> {
         if d > 0.0 {
             seq.push((Phase::WheelToCentre, Some(Leg::ALL[j]), st(moved, all, xy, roll, pitch)));
         }
-        if shift != 0.0 {
-            seq.push((Phase::BaseShift, None, self.shifted_stance(aligned, xy_shift)));
+        if let Some(p) = shifted {
+            seq.push((Phase::BaseShift, None, p));
         }
         seq.push((Phase::Lift, Some(leg), lift));
         seq.push((Phase::Swing, Some(leg), st(swing_feet, lifted, xy_shift, roll, pitch)));
@@ -874,22 +860,21 @@ impl<'a> Expander<'a> {
             // triangle of three feet; the stepping leg stretched by the shift), and each
             // is one posture where the whole sequence is up to nine and their segments.
             // The verdict is the same: the trial checks every keyframe.
-            let shift_m = self.candidate_shift(&aligned, shift);
-            let (lift, xy_shift) = self.lift_keyframe(leg, swing_z, &aligned, shift_m);
-            let shifted = (shift_m != 0.0).then(|| self.shifted_stance(&aligned, xy_shift));
-            let early = [Some((Phase::Lift, lift)), shifted.map(|p| (Phase::BaseShift, p))];
-            let early = early.iter().flatten();
-            if early.clone().any(|(_, p)| failed_early.contains(p)) {
+            let early = self.early_keyframes(leg, swing_z, &aligned, shift);
+            let checks =
+                [Some((Phase::Lift, early.lift)), early.shifted.map(|p| (Phase::BaseShift, p))];
+            let checks = checks.iter().flatten();
+            if checks.clone().any(|(_, p)| failed_early.contains(p)) {
                 continue;
             }
-            for &(phase, p) in early {
+            for &(phase, p) in checks {
                 if let Err(cause) = self.check_posture(&p) {
                     note(&mut best, SegmentFailure { phase: phase.name(), percent: 100.0, cause });
                     failed_early.push(p);
                     continue 'candidates;
                 }
             }
-            let seq = self.step_candidate(leg, swing_z, &aligned, shift);
+            let seq = self.step_candidate(leg, swing_z, &aligned, &early);
             if tried.contains(&seq) {
                 continue;
             }
@@ -1106,6 +1091,21 @@ impl ManoeuvreCheck<'_> {
     ) -> Result<(), MotionError> {
         self.expander(pre).expand_base_shift(PathKind::BaseShift, feet, to)
     }
+}
+
+/// The keyframes of a step candidate that most candidates fail at, built before the rest
+/// of its sequence ([`Expander::early_keyframes`]).
+#[derive(Debug, Clone, Copy)]
+struct EarlyKeyframes {
+    /// The base shift along the heading, m (0: none).
+    shift: f64,
+    /// The base's x, y after the shift.
+    xy_shift: [f64; 2],
+    /// The foot lifted to the swing height over where it stood, the base rolled and
+    /// shifted.
+    lift: Posture,
+    /// All feet down after the shift, where the base shifts.
+    shifted: Option<Posture>,
 }
 
 /// What a step candidate's alignment depends on: leg height, wheel and roll fractions.
