@@ -25,6 +25,11 @@ fn stands_on_all_eight_wheels_at_nominal_height_for_ten_seconds() {
     );
     assert!(s.upright && s.body_collisions.is_empty(), "{s:#?}");
     assert!(s.min_stability_margin_m > 0.2, "{s:#?}");
+    // The wheels carry the weight (MuJoCo's contact forces), each pair its share.
+    let weight = s.total_mass_kg * 9.81;
+    let carried: f64 = s.wheel_loads_end_n.iter().sum();
+    assert!((carried / weight - 1.0).abs() < 0.02, "{carried} N carried of {weight} N");
+    assert!(s.wheel_loads_end_n.iter().all(|f| *f > 0.15 * weight), "{s:#?}");
     // Standing still means standing still.
     let drift = (s.base_end[0] - s.base_start[0]).hypot(s.base_end[1] - s.base_start[1]);
     assert!(drift < 0.01, "drifted {drift} m");

@@ -29,7 +29,7 @@ use crate::rng::Rng;
 use crate::robot::Leg;
 use crate::robot::ik::IkError;
 use crate::scenario::{Outcome, Scenario, Stepping};
-use crate::sim::{BaseState, SimError, Simulation};
+use crate::sim::{BaseState, SimError, Simulation, TOUCHING_M};
 use crate::terrain::HeightMap;
 use crate::viz::{Recorder, VizError};
 use serde::Serialize;
@@ -618,8 +618,17 @@ fn actuate(sim: &mut Simulation, cmd: &Command) {
 }
 
 /// What the executor sees of the simulation, with `measured` as the planar base pose and
-/// the height of `base` (the simulated base, read once per tick).
-fn observe(sim: &Simulation, base: &BaseState, measured: Pose2) -> Observation {
+/// the height of `base` (the simulated base, read once per tick); wheels within
+/// `support_gap_m` of the terrain support it, as they do for the monitor.
+fn observe(sim: &Simulation, base: &BaseState, measured: Pose2, support_gap_m: f64) -> Observation {
+    let wheels = sim.wheel_contacts();
+    let within = |gap: f64| -> Vec<(Leg, [f64; 2])> {
+        wheels
+            .iter()
+            .filter(|c| c.distance <= gap)
+            .map(|c| (c.leg, [c.position[0], c.position[1]]))
+            .collect()
+    };
     Observation {
         time: sim.time(),
         base: measured,
@@ -628,12 +637,9 @@ fn observe(sim: &Simulation, base: &BaseState, measured: Pose2) -> Observation {
         steering: Leg::ALL.map(|l| sim.steering_angle(l)),
         steering_rate: Leg::ALL.map(|l| sim.steering_rate(l)),
         com: sim.center_of_mass(),
-        wheel_contacts: sim
-            .wheel_contacts()
-            .iter()
-            .filter(|c| c.touching())
-            .map(|c| (c.leg, [c.position[0], c.position[1]]))
-            .collect(),
+        wheel_contacts: within(TOUCHING_M),
+        support_contacts: within(support_gap_m),
+        wheel_loads: sim.wheel_loads(),
     }
 }
 
@@ -695,8 +701,9 @@ pub fn execute(
     let dt = sim.timestep();
     let substeps = ((1.0 / CONTROL_HZ) / dt).round().max(1.0) as usize;
     let control_dt = substeps as f64 * dt;
-    let mut monitor =
-        StabilityMonitor::new(MonitorLimits { settle_s: SETTLE_S, ..MonitorLimits::default() });
+    let limits = MonitorLimits { settle_s: SETTLE_S, ..MonitorLimits::default() };
+    let support_gap_m = limits.support_gap_m;
+    let mut monitor = StabilityMonitor::new(limits);
     let mut noise = opts.noise.map(|n| (n, Rng::from_state(n.seed)));
     let timeout = scenario.expect.timeout_s;
     let progress = SimProgress::new(&scenario.name, timeout, opts.progress);
@@ -727,7 +734,7 @@ pub fn execute(
             ),
             None => truth,
         };
-        let obs = observe(sim, &base, measured);
+        let obs = observe(sim, &base, measured, support_gap_m);
         let (cmd, status) = exec.tick(&obs, control_dt);
         match status {
             ExecStatus::Finished => {
@@ -849,6 +856,7 @@ pub fn execute(
             )?;
             r.log_trajectory_point(sim.time(), sim.base().position)?;
             r.log_scalar(sim.time(), "tracking_error_m", track)?;
+            r.log_wheel_loads(sim.time(), &sim.wheel_loads())?;
         }
         progress.set(sim.time());
     }
@@ -862,7 +870,7 @@ pub fn execute(
         while sim.time() < until {
             let base = sim.base();
             let truth = Pose2::new(base.position[0], base.position[1], base.rpy[2]);
-            let (cmd, _) = exec.tick(&observe(sim, &base, truth), control_dt);
+            let (cmd, _) = exec.tick(&observe(sim, &base, truth, support_gap_m), control_dt);
             actuate(sim, &cmd);
             if let (Some(r), Some(p)) = (&push_report, &opts.push)
                 && r.ended(p, sim.time())

@@ -92,6 +92,10 @@ pub struct SimSummary {
     pub body_collisions: Vec<String>,
     /// Monitor events.
     pub events: Vec<MonitorEvent>,
+    /// The robot's mass, from the model, kg.
+    pub total_mass_kg: f64,
+    /// Load on each leg's wheel pair at the end (MuJoCo's contact forces), N.
+    pub wheel_loads_end_n: [f64; 4],
 }
 
 fn pose4(sim: &Simulation) -> [f64; 4] {
@@ -172,6 +176,7 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
         {
             r.log_bodies(sim.time(), &sim.body_poses())?;
             r.log_stability(&sample, scenario.terrain_height(sample.com[0], sample.com[1]))?;
+            r.log_wheel_loads(sim.time(), &sim.wheel_loads())?;
         }
         progress.set(sim.time());
     }
@@ -202,5 +207,7 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
         upright: !monitor.tipped(),
         body_collisions: monitor.collided_bodies(),
         events: monitor.events,
+        total_mass_kg: robot.total_mass,
+        wheel_loads_end_n: sim.wheel_loads(),
     })
 }

@@ -465,6 +465,29 @@ impl Simulation {
         out
     }
 
+    /// The load on each leg's wheel pair, N: the normal forces of the contacts between its
+    /// wheels and the terrain (MuJoCo's constraint forces, `mj_contactForce`), summed.
+    pub fn wheel_loads(&self) -> [f64; 4] {
+        let mut loads = [0.0; 4];
+        for (k, c) in self.data.contact().iter().enumerate() {
+            let (Ok(g1), Ok(g2)) = (usize::try_from(c.geom1), usize::try_from(c.geom2)) else {
+                continue;
+            };
+            let wheel = match (self.terrain_geoms[g1], self.terrain_geoms[g2]) {
+                (true, false) => g2,
+                (false, true) => g1,
+                _ => continue,
+            };
+            let Some(i) = self.legs.iter().position(|l| l.wheel_geoms.contains(&wheel)) else {
+                continue;
+            };
+            if let Ok(f) = self.data.try_contact_force(k) {
+                loads[i] += f[0].max(0.0);
+            }
+        }
+        loads
+    }
+
     /// Names of robot geoms other than wheels that touch terrain now: body-terrain collisions.
     pub fn body_terrain_collisions(&self) -> Vec<String> {
         let wheels: Vec<usize> = self.legs.iter().flat_map(|l| l.wheel_geoms).collect();

@@ -10,6 +10,7 @@
 use crate::cost_image::RgbImage;
 use crate::geometry::Pose2;
 use crate::monitor::StabilitySample;
+use crate::robot::Leg;
 use crate::sim::{BodyPose, GeomKind, GeomShape};
 use crate::terrain::HeightMap;
 use std::path::{Path, PathBuf};
@@ -217,6 +218,19 @@ impl Recorder {
             self.rec
                 .log("plots/stability_margin_m", &rerun::Scalars::single(s.margin))
                 .map_err(|e| self.err(e))?;
+        }
+        Ok(())
+    }
+
+    /// Logs the load on each leg's wheel pair (N) as time series under
+    /// `plots/wheel_load_n/<leg>`: a pair at zero has left the ground, and the load-sharing
+    /// controllers (`control::load_sharing`) keep the diagonals near their share.
+    ///
+    /// # Errors
+    /// [`VizError`] if writing fails.
+    pub fn log_wheel_loads(&self, time: f64, loads: &[f64; 4]) -> Result<(), VizError> {
+        for (leg, load) in Leg::ALL.iter().zip(loads) {
+            self.log_scalar(time, &format!("wheel_load_n/{}", leg.prefix()), *load)?;
         }
         Ok(())
     }

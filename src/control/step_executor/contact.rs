@@ -2,24 +2,35 @@
 //! the foot only when MuJoCo reports contact (`ContactConfirm`, bounded extra lowering; no
 //! contact fails the step); a foot put down in an emergency or before a recovery is
 //! lowered until contact, then the step is retried from its lift or the robot recovers;
-//! a stance foot that loses the ground in a standing manoeuvre is lowered until it
-//! touches again (the stance compliance).
+//! in a standing manoeuvre on four feet the diagonals share the weight (`load_sharing`),
+//! and on fewer a stance foot that loses the ground is lowered until it touches again
+//! (the stance compliance).
 
 use super::{AfterPutDown, Command, ExecEventKind, ExecFailure, Mode, Observation, StepExecutor};
 use crate::control::foot_contact::{ContactConfirm, ContactConfirmConfig, ContactStatus};
 use crate::robot::Leg;
 
 impl StepExecutor {
-    /// The stance legs' compliance in the standing modes: a leg the commanded posture has
-    /// bearing weight whose wheels MuJoCo reports touching nothing is lowered below its
-    /// keyframe at [`ExecutorConfig::leg_extend_speed_mps`], at most
-    /// [`ExecutorConfig::max_leg_extension_m`], until they touch; the extension is kept
-    /// (as the placed foot's extra lowering is) until the next drive run takes it over.
-    /// The position-servoed legs give under the weight, most in front of a shifted CoM: on
-    /// a stair descent a planned base shift pitched the base 2.2° past its keyframe, a rear
-    /// pair on its tread rose 1 cm off it, and the lift that followed measured −6.4 cm of
-    /// margin on the two legs left (8.5 cm planned) and was aborted. The leg a step is about
-    /// to lift, is confirming or is putting down is left to the step.
+    /// The stance legs' compliance in the standing modes. On four feet (all four in
+    /// contact in the commanded posture) the wheel loads are shared as in a drive run
+    /// ([`StepExecutor::share_load`]: the light diagonal's feet lowered below their
+    /// keyframes, the heavy one's raised back toward them): on a 6 × 0.165 m flight
+    /// climbed 54° off its axis the front-left pair carried 42 N of 569 when a shift back
+    /// began, lost the ground with the leg 13 cm short of its reach, and the robot went
+    /// over backwards. Waiting to lift a foot (the guard), the target is that foot
+    /// unloaded ([`crate::control::load_sharing::unloaded_warp`]), so the support legs
+    /// take the weight, and sag under it, before the guard measures the margin and the
+    /// foot leaves (generated stairs seed 4: lifted at 5.1 cm of margin under load, a rear
+    /// foot's swing fell to 3.1 cm; unloaded first, to 4.1). With a leg stepping, or no
+    /// loads measured, a leg the commanded posture has bearing weight whose wheels MuJoCo
+    /// reports touching nothing is lowered at [`ExecutorConfig::leg_extend_speed_mps`], at
+    /// most [`ExecutorConfig::max_leg_extension_m`], until they touch: the position-
+    /// servoed legs give under the weight, most in front of a shifted CoM (on a stair
+    /// descent a planned base shift pitched the base 2.2° past its keyframe, a rear pair on
+    /// its tread rose 1 cm off it, and the lift that followed measured −6.4 cm of margin on
+    /// the two legs left, 8.5 cm planned, and was aborted). Extensions are kept (as the
+    /// placed foot's extra lowering is) until the next drive run takes them over. A leg a
+    /// step has lifted, is confirming or is putting down is left to the step.
     pub(super) fn comply_stance(&mut self, obs: &Observation, dt: f64) {
         let stepping = match &self.mode {
             Mode::Segment { .. } | Mode::CheckStance { .. } | Mode::Slide { .. } => None,
@@ -27,6 +38,23 @@ impl StepExecutor {
             Mode::PutDown { leg, .. } => Some(*leg),
             _ => return,
         };
+        // On four feet the diagonals share the weight; waiting to lift a foot (the guard),
+        // the one about to lift is unloaded first.
+        let sharing = match &self.mode {
+            _ if !self.cmd.contact.iter().all(|&on| on) => None,
+            Mode::Guard { .. } => Some(stepping),
+            _ if stepping.is_none() => Some(None),
+            _ => None,
+        };
+        if let Some(unloaded) = sharing {
+            let mut extension = self.foot_offset.map(|o| -o[2]);
+            if self.share_load(&self.cmd, obs, unloaded, &mut extension, dt) {
+                for (o, e) in self.foot_offset.iter_mut().zip(extension) {
+                    o[2] = -e;
+                }
+                return;
+            }
+        }
         let c = &self.config;
         for leg in Leg::ALL {
             let i = leg.index();
@@ -161,6 +189,7 @@ impl StepExecutor {
 
 #[cfg(test)]
 mod tests {
+    use crate::control::load_sharing::unloaded_warp;
     use crate::control::step_executor::actuation::{REACH_SPARE_M, reach_excess};
     use crate::control::step_executor::test_support::{
         all_contacts, config, contacts_without, ground, key, obs, robot, standing, step_path,
@@ -433,5 +462,91 @@ mod tests {
             tick(&mut ex, &all_contacts(&feet));
         }
         assert_eq!(z(&ex)[Leg::RearRight.index()], -config().max_leg_extension_m);
+    }
+
+    #[test]
+    fn on_four_feet_the_light_diagonal_is_lowered_until_the_loads_balance() {
+        // A long planned base shift on four feet (no leg stepping), the CoM over the
+        // centre of the rectangle of feet (target warp zero). All the weight on front-right
+        // and rear-left, a warp of −1: front-left and rear-right go down 0.25 m/s × 1 =
+        // 2.5 mm per 10 ms tick, 1 cm in 4 ticks, though every wheel touches. Balanced
+        // loads keep it; the weight on the other diagonal moves the centimetre to the
+        // other diagonal in 4 ticks.
+        let a = standing();
+        let shift =
+            vec![key(0.0, Phase::Start, None, &a), key(100.0, Phase::PlannedBaseShift, None, &a)];
+        let mut ex = StepExecutor::new(&robot(), config(), shift, ground());
+        let weight = robot().total_mass * 9.81;
+        let contacts = all_contacts(&a.feet);
+        let mut t = 0.0;
+        let mut tick = |ex: &mut StepExecutor, loads: [f64; 4]| {
+            t += 0.01;
+            let mut o = obs(t, ex, &contacts, [0.0, 0.0, 0.4]);
+            o.wheel_loads = loads.map(|f| f * weight);
+            ex.tick(&o, 0.01);
+            ex.foot_offset.map(|o| o[2])
+        };
+        let close = |a: [f64; 4], b: [f64; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+        let mut z = [0.0; 4];
+        for _ in 0..4 {
+            z = tick(&mut ex, [0.0, 0.5, 0.5, 0.0]);
+        }
+        assert!(matches!(ex.mode, Mode::Segment { .. }), "{:?}", ex.mode);
+        assert!(close(z, [-0.01, 0.0, 0.0, -0.01]), "{z:?}");
+        for _ in 0..10 {
+            z = tick(&mut ex, [0.25; 4]);
+        }
+        assert!(close(z, [-0.01, 0.0, 0.0, -0.01]), "{z:?}");
+        for _ in 0..4 {
+            z = tick(&mut ex, [0.5, 0.0, 0.0, 0.5]);
+        }
+        assert!(close(z, [0.0, -0.01, -0.01, 0.0]), "{z:?}");
+    }
+
+    #[test]
+    fn a_foot_waiting_to_lift_is_unloaded_first() {
+        // Waiting to lift FL (the guard), the loads equal on four feet (warp 0), the CoM at
+        // (−0.1, −0.1), inside the other three's triangle. The target is the warp with FL
+        // carrying nothing (`unloaded_warp`, negative here: front-right and rear-left take
+        // the weight), so front-right and rear-left are lowered at 0.25 m/s × the error
+        // per tick, the error being 0 − that warp.
+        let keys = step_path();
+        let feet = keys[0].feet;
+        let com = [-0.1, -0.1, 0.4];
+        let mut ex = StepExecutor::new(&robot(), config(), keys, ground());
+        let weight = robot().total_mass * 9.81;
+        let contacts = all_contacts(&feet);
+        let mut t = 0.0;
+        let mut tick = |ex: &mut StepExecutor| {
+            t += 0.01;
+            let mut o = obs(t, ex, &contacts, com);
+            o.wheel_loads = [0.25 * weight; 4];
+            ex.tick(&o, 0.01);
+            ex.foot_offset.map(|o| o[2])
+        };
+        let mut z = tick(&mut ex);
+        for _ in 0..100 {
+            if matches!(ex.mode, Mode::Guard { .. }) {
+                break;
+            }
+            z = tick(&mut ex);
+        }
+        assert!(matches!(ex.mode, Mode::Guard { .. }), "{:?}", ex.mode);
+        let target =
+            unloaded_warp(&feet.map(|f| [f[0], f[1]]), [com[0], com[1]], 0).expect("a triangle");
+        assert!(target < -0.1, "{target}");
+        let per_tick = 0.25 * (0.0 - target) * 0.01;
+        let before = z;
+        for _ in 0..10 {
+            z = tick(&mut ex);
+        }
+        assert!(matches!(ex.mode, Mode::Guard { .. }), "{:?}", ex.mode);
+        for leg in [Leg::FrontRight, Leg::RearLeft] {
+            let lowered = before[leg.index()] - z[leg.index()];
+            assert!((lowered - 10.0 * per_tick).abs() < 1e-12, "{leg:?}: {lowered}");
+        }
+        for leg in [Leg::FrontLeft, Leg::RearRight] {
+            assert!(z[leg.index()] >= before[leg.index()], "{leg:?}: {z:?}");
+        }
     }
 }

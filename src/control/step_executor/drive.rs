@@ -3,13 +3,19 @@
 //! posture interpolated at the robot's progress along the run. The follower's end of the
 //! run hands over to the next keyframe; too large a cross-track error fails.
 //!
-//! **Leg compliance.** The legs are position-controlled, and four stiff legs on ground the
+//! **Load sharing.** The legs are position-controlled, and four stiff legs on ground the
 //! height map knows only to a cell rest on three of them: the fourth pair hangs a few
-//! millimetres up, and the CoM sits next to the diagonal of the other three (generated
-//! clutter: 0.6 cm of margin over bumps under 5 cm). A leg whose wheels touch nothing is
-//! extended at `leg_extend_speed_mps` until they do (at most `max_leg_extension_m`),
-//! and the extension is given back at the slower `leg_release_speed_mps` while they
-//! touch, so every pair keeps the ground and the extension does not outlive the bump.
+//! millimetres up, and the CoM sits next to the diagonal of the other three
+//! (`control::load_sharing`). The legs of the diagonal that carries less than its share of
+//! the weight (MuJoCo's wheel loads against the balancing loads whose smallest is largest)
+//! are lengthened, and the other diagonal's shortened back to their planned length, at
+//! `load_sharing_gain_mps` per unit of the error (at most `max_leg_extension_m`); what all
+//! four share is given back at `leg_release_speed_mps`, so the extension does not outlive
+//! the bump. The gain is a third of where the loop starts to ring: at 0.8 m/s the warp
+//! flipped sign every 10 ms tick on flat ground, at 0.6 it settled (generated clutter seed
+//! 335). It replaced lengthening only a leg whose wheels touch nothing, at 5 cm/s: that
+//! came after the load had gone, and over a 3 cm bump the chassis rocked from one diagonal
+//! to the other, a pair 4 mm up for 0.1 s with the CoM 0.85 cm inside the others' diagonal.
 //!
 //! **The base follows the ground slowly.** The feet follow the height map under the
 //! wheels, and the base rises with the highest foot, but no faster than
@@ -17,7 +23,9 @@
 //! when the rise stops.
 
 use super::actuation::pairs_in_base;
+use super::interface::STANDARD_GRAVITY;
 use super::{Command, ExecFailure, Mode, Observation, StepExecutor, planar};
+use crate::control::load_sharing::{WARP_SIGN, measured_warp, target_warp, unloaded_warp};
 use crate::control::path_follower::{FollowerStatus, PathFollower};
 use crate::geometry::wrap_angle;
 use crate::motion::kinematics::{Posture, interpolate};
@@ -88,19 +96,61 @@ impl StepExecutor {
     }
 
     /// `p` with each leg extended by its compliance (see the module docs), updated for a
-    /// tick of `dt` from the wheel contacts in `obs`.
+    /// tick of `dt` from the wheel loads in `obs` ([`Self::share_load`]); what all four
+    /// legs share is given back at `leg_release_speed_mps`.
     fn complied(&mut self, mut p: Posture, obs: &Observation, dt: f64) -> Posture {
-        let c = &self.config;
-        for leg in Leg::ALL {
-            let e = &mut self.drive_extension[leg.index()];
-            *e = if obs.leg_in_contact(leg) {
-                (*e - c.leg_release_speed_mps * dt).max(0.0)
-            } else {
-                (*e + c.leg_extend_speed_mps * dt).min(c.max_leg_extension_m)
-            };
-            p.feet[leg.index()][2] -= *e;
+        let mut extension = self.drive_extension;
+        if self.share_load(&p, obs, None, &mut extension, dt) {
+            let shared = extension.iter().copied().fold(f64::INFINITY, f64::min);
+            let back = shared.min(self.config.leg_release_speed_mps * dt);
+            for e in &mut extension {
+                *e -= back;
+            }
+            self.drive_extension = extension;
+        }
+        for (f, e) in p.feet.iter_mut().zip(self.drive_extension) {
+            f[2] -= e;
         }
         p
+    }
+
+    /// One tick of load sharing on four feet (`control::load_sharing`): the legs of the
+    /// diagonal that carries less than its share lengthen, the others' shorten, each
+    /// `extension` (below `p`'s feet, m) moved by `load_sharing_gain_mps` × the warp error ×
+    /// `dt`, never below zero nor lengthened beyond `max_leg_extension_m`. The warp error
+    /// is the measured warp ([`measured_warp`]) less the target warp of `p`'s feet and the
+    /// measured CoM, both in the base's frame ([`target_warp`]). Drive runs and the
+    /// standing manoeuvres on four feet (`contact`) share it. False, and nothing
+    /// changed, while the wheels carry less than a quarter of the weight (a bounce: loads
+    /// say nothing of the warp then) or the feet stand on one line.
+    pub(super) fn share_load(
+        &self,
+        p: &Posture,
+        obs: &Observation,
+        unloaded: Option<Leg>,
+        extension: &mut [f64; 4],
+        dt: f64,
+    ) -> bool {
+        let c = &self.config;
+        let planned = planar(p);
+        let feet = p.feet.map(|f| planned.inverse_transform([f[0], f[1]]));
+        let com = obs.base.inverse_transform([obs.com[0], obs.com[1]]);
+        let carried =
+            obs.wheel_loads.iter().sum::<f64>() >= 0.25 * self.robot.total_mass * STANDARD_GRAVITY;
+        let target = match unloaded {
+            Some(leg) => unloaded_warp(&feet, com, leg.index()),
+            None => target_warp(&feet, com),
+        };
+        let (true, Some(warp), Some(target)) = (carried, measured_warp(&obs.wheel_loads), target)
+        else {
+            return false;
+        };
+        let rate = c.load_sharing_gain_mps * (warp - target);
+        for (e, s) in extension.iter_mut().zip(WARP_SIGN) {
+            let next = *e - s * rate * dt;
+            *e = if next > *e { next.min(c.max_leg_extension_m.max(*e)) } else { next.max(0.0) };
+        }
+        true
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -173,7 +223,6 @@ mod tests {
     use crate::control::step_executor::StepExecutor;
     use crate::control::step_executor::test_support::{config, obs, robot, standing, step_path};
     use crate::geometry::Pose2;
-    use crate::robot::Leg;
     use crate::terrain::HeightMap;
 
     /// A 4 cm bump under the front-left foot's keyframe position (hip at (0.35, 0.32),
@@ -238,33 +287,66 @@ mod tests {
     }
 
     #[test]
-    fn a_leg_whose_wheels_lost_the_ground_extends_until_they_touch_then_gives_it_back() {
-        // 10 ms ticks. Front-left off the ground for 0.2 s: 0.05 m/s × 0.2 s = 1 cm lower.
-        // Then in contact: 0.01 m/s back, 0.5 s = 5 mm. Never beyond 3 cm, never below 0.
+    fn the_light_diagonal_lengthens_until_the_loads_balance() {
+        // The reference stance is a rectangle of feet, the CoM at its centre: target warp
+        // zero. All the
+        // weight on front-right + rear-left is a warp of −1: front-left and rear-right
+        // lengthen at 0.25 m/s × 1 = 2.5 mm per 10 ms tick (the others stay at their
+        // planned length), 1 cm after 4 ticks. Balanced loads hold it; the weight on the
+        // other diagonal hands it over in 4 ticks; a bounce (a tenth of the weight on the
+        // wheels) changes nothing; and nothing lengthens beyond 3 cm.
         let flat = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |_, _| 0.0).unwrap();
         let mut ex = StepExecutor::new(&robot(), config(), step_path(), flat);
         let p = standing();
-        let all: Vec<(Leg, [f64; 2])> = Leg::ALL.iter().map(|&l| (l, [0.0, 0.0])).collect();
-        let no_fl: Vec<(Leg, [f64; 2])> =
-            all.iter().copied().filter(|(l, _)| *l != Leg::FrontLeft).collect();
-        let lowered = |q: &crate::motion::Posture, i: usize| p.feet[i][2] - q.feet[i][2];
+        let weight = robot().total_mass * 9.81;
+        let mut o = obs(0.0, &ex, &[], [0.0; 3]);
+        let mut tick = |ex: &mut StepExecutor, loads: [f64; 4]| {
+            o.wheel_loads = loads.map(|f| f * weight);
+            let q = ex.complied(p, &o, 0.01);
+            std::array::from_fn::<f64, 4, _>(|i| p.feet[i][2] - q.feet[i][2])
+        };
+        let close = |a: [f64; 4], b: [f64; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+        assert!((ex.config.load_sharing_gain_mps - 0.25).abs() < 1e-12);
+        let mut lowered = [0.0; 4];
+        for _ in 0..4 {
+            lowered = tick(&mut ex, [0.0, 0.5, 0.5, 0.0]);
+        }
+        assert!(close(lowered, [0.01, 0.0, 0.0, 0.01]), "{lowered:?}");
+        for _ in 0..10 {
+            lowered = tick(&mut ex, [0.25; 4]);
+        }
+        assert!(close(lowered, [0.01, 0.0, 0.0, 0.01]), "{lowered:?}");
+        // Handing over, all four legs are extended for three ticks, and the part they
+        // share goes back at 0.01 m/s: 0.1 mm a tick, 0.3 mm in all.
+        for _ in 0..4 {
+            lowered = tick(&mut ex, [0.5, 0.0, 0.0, 0.5]);
+        }
+        assert!(close(lowered, [0.0, 0.0097, 0.0097, 0.0]), "{lowered:?}");
+        lowered = tick(&mut ex, [0.1, 0.0, 0.0, 0.0]);
+        assert!(close(lowered, [0.0, 0.0097, 0.0097, 0.0]), "{lowered:?}");
+        for _ in 0..100 {
+            lowered = tick(&mut ex, [0.5, 0.0, 0.0, 0.5]);
+        }
+        assert!(close(lowered, [0.0, 0.03, 0.03, 0.0]), "{lowered:?}");
+    }
+
+    #[test]
+    fn what_all_four_legs_share_is_given_back_slowly() {
+        // Every leg 1 cm long (a stance compliance's extension carried into the run), the
+        // loads balanced: the warp needs nothing, and the shared centimetre goes back at
+        // 0.01 m/s, 0.1 mm per tick, keeping the legs equal.
+        let flat = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |_, _| 0.0).unwrap();
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), flat);
+        ex.drive_extension = [0.01; 4];
+        let p = standing();
+        let mut o = obs(0.0, &ex, &[], [0.0; 3]);
+        o.wheel_loads = [0.25 * robot().total_mass * 9.81; 4];
         let mut q = p;
-        for _ in 0..20 {
-            q = ex.complied(p, &obs(0.0, &ex, &no_fl, [0.0; 3]), 0.01);
-        }
-        assert!((lowered(&q, 0) - 0.01).abs() < 1e-9, "{}", lowered(&q, 0));
-        assert!((1..4).all(|i| lowered(&q, i) == 0.0));
         for _ in 0..50 {
-            q = ex.complied(p, &obs(0.0, &ex, &all, [0.0; 3]), 0.01);
+            q = ex.complied(p, &o, 0.01);
         }
-        assert!((lowered(&q, 0) - 0.005).abs() < 1e-9, "{}", lowered(&q, 0));
-        for _ in 0..200 {
-            q = ex.complied(p, &obs(0.0, &ex, &all, [0.0; 3]), 0.01);
+        for i in 0..4 {
+            assert!((p.feet[i][2] - q.feet[i][2] - 0.005).abs() < 1e-9, "{i}: {q:?}");
         }
-        assert_eq!(lowered(&q, 0), 0.0);
-        for _ in 0..200 {
-            q = ex.complied(p, &obs(0.0, &ex, &no_fl, [0.0; 3]), 0.01);
-        }
-        assert!((lowered(&q, 0) - 0.03).abs() < 1e-9, "{}", lowered(&q, 0));
     }
 }

@@ -15,7 +15,7 @@ use crate::stability::stability_margin;
 use serde::Serialize;
 
 /// Gravity, m/s²: MuJoCo's default, which `models/momaro.xml` keeps.
-const STANDARD_GRAVITY: f64 = 9.81;
+pub(super) const STANDARD_GRAVITY: f64 = 9.81;
 
 /// Tuning of the executor.
 #[derive(Debug, Clone, PartialEq)]
@@ -111,12 +111,18 @@ pub struct ExecutorConfig {
     pub driving_leg_height_m: f64,
     /// Base pitch as a fraction of the slope (Sec. VI-B).
     pub pitch_fraction: f64,
-    /// Speed at which a leg whose wheels have lost the ground is extended, m/s: in a drive
-    /// run (`drive`) and, for the legs a standing manoeuvre plans in contact, while
-    /// standing (`StepExecutor::comply_stance`).
+    /// Speed at which a leg whose wheels have lost the ground is extended while standing,
+    /// for the legs a standing manoeuvre plans in contact (`StepExecutor::comply_stance`),
+    /// m/s.
     pub leg_extend_speed_mps: f64,
-    /// Speed at which a drive run gives the extension back while the wheels touch, m/s.
+    /// Speed at which a drive run gives back the extension all four legs share, m/s.
     pub leg_release_speed_mps: f64,
+    /// Load sharing on four feet ([`crate::control::load_sharing`]; drive runs and
+    /// standing, `StepExecutor::share_load`): the speed at which the legs of the diagonal
+    /// that carries less than its share of the weight lengthen (and the other diagonal's
+    /// shorten back), per unit of warp error (the fraction of the weight on the wrong
+    /// diagonal), m/s.
+    pub load_sharing_gain_mps: f64,
     /// Largest extension of a leg below its keyframe (driving or standing), m.
     pub max_leg_extension_m: f64,
     /// Fastest rise or fall of a drive run's base with the ground under its wheels, m/s
@@ -168,6 +174,7 @@ impl ExecutorConfig {
             pitch_fraction: params.base_pitch_slope_fraction,
             leg_extend_speed_mps: 0.05,
             leg_release_speed_mps: 0.01,
+            load_sharing_gain_mps: 0.25,
             max_leg_extension_m: 0.03,
             base_rise_speed_mps: (2.0 * STANDARD_GRAVITY * 0.001).sqrt(),
             contact: ContactConfirmConfig::default(),
@@ -195,8 +202,17 @@ pub struct Observation {
     pub steering_rate: [f64; 4],
     /// Whole-robot CoM, m.
     pub com: [f64; 3],
-    /// Horizontal contact points of the wheels touching terrain, with their legs.
+    /// Horizontal contact points of the wheels touching terrain, with their legs: what
+    /// confirms a placed foot, and what the stance compliance and the slide go by.
     pub wheel_contacts: Vec<(Leg, [f64; 2])>,
+    /// Horizontal contact points of the wheels that support the robot as the monitor
+    /// counts them (within [`crate::monitor::MonitorLimits::support_gap_m`] of the terrain,
+    /// a superset of `wheel_contacts`): the support margins are taken over these, so the
+    /// executor's margin is the monitor's.
+    pub support_contacts: Vec<(Leg, [f64; 2])>,
+    /// Normal load on each leg's wheel pair, N (MuJoCo's contact forces); all zero where
+    /// nothing measures them.
+    pub wheel_loads: [f64; 4],
 }
 
 impl Observation {
@@ -205,18 +221,19 @@ impl Observation {
         self.wheel_contacts.iter().any(|(l, _)| *l == leg)
     }
 
-    /// Margin of the CoM over the contacts of every leg but `lifted`, m.
+    /// Margin of the CoM over the support contacts of every leg but `lifted`, m.
     pub fn support_margin(&self, lifted: Leg) -> f64 {
-        let pts: Vec<[f64; 2]> =
-            self.wheel_contacts.iter().filter(|(l, _)| *l != lifted).map(|(_, p)| *p).collect();
-        stability_margin(&pts, [self.com[0], self.com[1]])
+        stability_margin(&self.supports_without(lifted), [self.com[0], self.com[1]])
     }
 
-    /// Centroid of the contacts of every leg but `lifted` (vertex mean of their hull).
+    /// Centroid of the support contacts of every leg but `lifted` (vertex mean of their
+    /// hull).
     pub fn support_centroid(&self, lifted: Leg) -> Option<[f64; 2]> {
-        let pts: Vec<[f64; 2]> =
-            self.wheel_contacts.iter().filter(|(l, _)| *l != lifted).map(|(_, p)| *p).collect();
-        support_centroid(&pts)
+        support_centroid(&self.supports_without(lifted))
+    }
+
+    fn supports_without(&self, lifted: Leg) -> Vec<[f64; 2]> {
+        self.support_contacts.iter().filter(|(l, _)| *l != lifted).map(|(_, p)| *p).collect()
     }
 }
 
@@ -411,6 +428,47 @@ pub struct ExecEvent {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn support_margins_count_the_wheels_the_monitor_counts() {
+        // Feet at (±0.35, ±0.32), each pair on its outer wheel (y = ±0.40), the inner
+        // wheels (y = ±0.24) 1.2 mm up, as on a rolled base: touching, only the outer
+        // wheels; within the monitor's 4 mm support gap, the inner ones too. CoM at the
+        // origin, front-left lifted. Over the outer wheels of FR, RL and RR the hull edge
+        // from RL (−0.35, 0.40) to FR (0.35, −0.40) passes through the origin: margin 0.
+        // With the inner wheels the edge runs from RL's outer (−0.35, 0.40) to FR's inner
+        // wheel (0.35, −0.24), direction (0.7, −0.64): the origin is
+        // |(−0.35)(−0.64) − 0.40 · 0.7| / |(0.7, −0.64)| = 0.056 / 0.9485 = 5.9 cm inside,
+        // which is 0.08 · 0.35 / |(0.35, 0.32)|.
+        let outer = |l: Leg, x: f64, y: f64| (l, [x, y + y.signum() * 0.08]);
+        let inner = |l: Leg, x: f64, y: f64| (l, [x, y - y.signum() * 0.08]);
+        let feet = [
+            (Leg::FrontLeft, 0.35, 0.32),
+            (Leg::FrontRight, 0.35, -0.32),
+            (Leg::RearLeft, -0.35, 0.32),
+            (Leg::RearRight, -0.35, -0.32),
+        ];
+        let touching: Vec<_> = feet.iter().map(|&(l, x, y)| outer(l, x, y)).collect();
+        let mut within_gap = touching.clone();
+        within_gap.extend(feet.iter().map(|&(l, x, y)| inner(l, x, y)));
+        let obs = Observation {
+            time: 0.0,
+            base: Pose2::new(0.0, 0.0, 0.0),
+            base_z: None,
+            joints: [[0.0; 3]; 4],
+            steering: [0.0; 4],
+            steering_rate: [0.0; 4],
+            com: [0.0, 0.0, 0.4],
+            wheel_contacts: touching,
+            support_contacts: within_gap,
+            wheel_loads: [0.0; 4],
+        };
+        let expected = 0.08 * 0.35 / 0.35f64.hypot(0.32);
+        let m = obs.support_margin(Leg::FrontLeft);
+        assert!((m - expected).abs() < 1e-12, "{m} vs {expected}");
+        let only_touching = Observation { support_contacts: obs.wheel_contacts.clone(), ..obs };
+        assert!(only_touching.support_margin(Leg::FrontLeft).abs() < 1e-12);
+    }
 
     #[test]
     fn every_failure_serialises_in_an_event() {

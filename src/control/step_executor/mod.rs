@@ -2,13 +2,16 @@
 //! (`motion::DetailedPath`, Sec. VI) on the robot, one control tick at a time.
 //!
 //! A pure state machine: each tick it takes an [`Observation`] (measured base pose,
-//! joints, steering, MuJoCo's CoM and the wheels MuJoCo reports touching terrain) and
-//! returns actuator targets ([`Command`]). The simulation loop lives in `jobs::run`.
+//! joints, steering, MuJoCo's CoM, the wheels MuJoCo reports touching terrain or within
+//! the monitor's support gap, and the load on each wheel pair) and returns actuator
+//! targets ([`Command`]). The simulation loop lives in `jobs::run`.
 //!
 //! - **Drive** runs (consecutive [`Phase::Drive`] keyframes) go to the B-spline
 //!   [`PathFollower`] (Sec. IX) and the omnidirectional wheel kinematics; the legs hold the
-//!   keyframes' posture interpolated at the robot's progress. The follower stops at the run's
-//!   end (within its 2 cm / 2° goal tolerance) and stepping starts at once.
+//!   keyframes' posture interpolated at the robot's progress, the legs of the diagonal
+//!   that carries less than its share of the weight lengthened (`drive`, load sharing).
+//!   The follower stops at the run's end (within its 2 cm / 2° goal tolerance) and
+//!   stepping starts at once.
 //! - **Other segments** track the linear interpolation between keyframes with a smoothstep
 //!   time law over the generator's keyframe time (longer if the servos lag): leg joint
 //!   targets from the sagittal IK of the interpolated posture (base height, roll, pitch,
@@ -44,8 +47,11 @@
 //!   or turn the stance, yet a planned base shift ends on a lattice cell up to half a
 //!   cell to the side of its heading, stance wheels creep, and a base rolled while
 //!   pitched less than its feet's line turns the robot.
-//! - **Before a lift** the support margin measured from MuJoCo (CoM over the wheel
-//!   contacts of the three support legs) must reach [`ExecutorConfig::min_lift_margin_m`]
+//! - **Before a lift** the support margin measured from MuJoCo (CoM over the wheels of the
+//!   three support legs that the monitor counts as support, within its 4 mm gap: a pair
+//!   standing on one wheel with the other a millimetre up still holds the robot, and
+//!   counting only touching wheels aborted a stair step at 3.3 cm where the monitor
+//!   measured 13) must reach [`ExecutorConfig::min_lift_margin_m`]
 //!   (2 cm) plus a reserve for the sag of the compliant support legs when the foot unloads
 //!   ([`ExecutorConfig::lift_margin_reserve_m`]). If it does not, the base is moved toward
 //!   the support triangle's centroid in bounded increments: longitudinally by a base shift,
@@ -210,7 +216,7 @@ pub struct StepExecutor {
     cmd: Posture,
     /// Per-leg foot offsets (plan coordinates): landing corrections and extra lowering.
     foot_offset: [[f64; 3]; 4],
-    /// Per-leg extension of a drive run's legs whose wheels lost the ground, m (`drive`).
+    /// Per-leg extension of a drive run's legs by their load sharing, m (`drive`).
     drive_extension: [f64; 4],
     /// A drive run's rise of the base with the ground under its wheels, m (`drive`).
     drive_rise: f64,

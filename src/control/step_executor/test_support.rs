@@ -59,6 +59,8 @@ pub(super) fn obs(
         steering_rate: [0.0; 4],
         com,
         wheel_contacts: contacts.to_vec(),
+        support_contacts: contacts.to_vec(),
+        wheel_loads: [0.0; 4],
     }
 }
 
