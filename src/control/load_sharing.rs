@@ -76,24 +76,6 @@ pub fn target_warp(feet: &[[f64; 2]; 4], com: [f64; 2]) -> Option<f64> {
     Some((0..4).map(|i| WARP_SIGN[i] * (f0[i] + best.1 * n[i])).sum())
 }
 
-/// The warp of the loads that balance the weight with `unloaded`'s support carrying
-/// nothing (the other three's loads fixed by the three equilibrium equations), as a
-/// fraction of the weight: where a leg about to lift should leave the weight before it
-/// leaves the ground. `None` for the other three on one line.
-pub fn unloaded_warp(feet: &[[f64; 2]; 4], com: [f64; 2], unloaded: usize) -> Option<f64> {
-    let others: Vec<usize> = (0..4).filter(|&i| i != unloaded).collect();
-    let a = Matrix3::from_fn(|r, c| match r {
-        0 => 1.0,
-        _ => feet[others[c]][r - 1] - com[r - 1],
-    });
-    if a.determinant().abs() < 1e-12 {
-        return None;
-    }
-    // Moments about the CoM: Σ F_i (p_i − c) = 0, Σ F_i = 1.
-    let loads = a.try_inverse()? * Vector3::new(1.0, 0.0, 0.0);
-    Some(others.iter().zip(loads.iter()).map(|(&i, f)| WARP_SIGN[i] * f).sum())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -175,21 +157,6 @@ mod tests {
         let brute: f64 = best.1.iter().zip(WARP_SIGN).map(|(f, s)| s * f).sum();
         assert!((w - brute).abs() < 1e-4, "{w} vs {brute}");
         assert!(w > w0, "the front-left diagonal gets more than the least-norm loads give");
-    }
-
-    #[test]
-    fn a_leg_about_to_lift_leaves_its_load_to_the_other_three() {
-        // Feet (±0.4, ±0.3), CoM (−0.1, −0.05), front-left unloaded. By hand, with a, b, c
-        // the loads of front-right, rear-left, rear-right: a + b + c = 1; moments about
-        // the CoM along x, 0.5 a − 0.3 (b + c) = 0, so a = 3/8; along y,
-        // −0.25 a + 0.35 b − 0.25 c = 0 with c = 5/8 − b, so b = 5/12 and c = 5/24.
-        // Warp −a − b + c = −7/12.
-        let feet = [[0.4, 0.3], [0.4, -0.3], [-0.4, 0.3], [-0.4, -0.3]];
-        let w = unloaded_warp(&feet, [-0.1, -0.05], 0).unwrap();
-        assert!(close(w, -7.0 / 12.0), "{w}");
-        // Three feet on one line cannot hold it.
-        let line = [[0.4, 0.3], [0.0, 0.0], [-0.4, -0.3], [-0.4, 0.3]];
-        assert_eq!(unloaded_warp(&line, [0.0, 0.1], 3), None);
     }
 
     #[test]

@@ -17,12 +17,8 @@ impl StepExecutor {
     /// keyframes, the heavy one's raised back toward them): on a 6 × 0.165 m flight
     /// climbed 54° off its axis the front-left pair carried 42 N of 569 when a shift back
     /// began, lost the ground with the leg 13 cm short of its reach, and the robot went
-    /// over backwards. Waiting to lift a foot (the guard), the target is that foot
-    /// unloaded ([`crate::control::load_sharing::unloaded_warp`]), so the support legs
-    /// take the weight, and sag under it, before the guard measures the margin and the
-    /// foot leaves (generated stairs seed 4: lifted at 5.1 cm of margin under load, a rear
-    /// foot's swing fell to 3.1 cm; unloaded first, to 4.1). With a leg stepping, or no
-    /// loads measured, a leg the commanded posture has bearing weight whose wheels MuJoCo
+    /// over backwards. With a leg stepping (waiting to lift included), or no loads
+    /// measured, a leg the commanded posture has bearing weight whose wheels MuJoCo
     /// reports touching nothing is lowered at [`ExecutorConfig::leg_extend_speed_mps`], at
     /// most [`ExecutorConfig::max_leg_extension_m`], until they touch: the position-
     /// servoed legs give under the weight, most in front of a shifted CoM (on a stair
@@ -38,17 +34,9 @@ impl StepExecutor {
             Mode::PutDown { leg, .. } => Some(*leg),
             _ => return,
         };
-        // On four feet the diagonals share the weight; waiting to lift a foot (the guard),
-        // the one about to lift is unloaded first.
-        let sharing = match &self.mode {
-            _ if !self.cmd.contact.iter().all(|&on| on) => None,
-            Mode::Guard { .. } => Some(stepping),
-            _ if stepping.is_none() => Some(None),
-            _ => None,
-        };
-        if let Some(unloaded) = sharing {
+        if stepping.is_none() && self.cmd.contact.iter().all(|&on| on) {
             let mut extension = self.foot_offset.map(|o| -o[2]);
-            if self.share_load(&self.cmd, obs, unloaded, &mut extension, dt) {
+            if self.share_load(&self.cmd, obs, &mut extension, dt) {
                 for (o, e) in self.foot_offset.iter_mut().zip(extension) {
                     o[2] = -e;
                 }
@@ -189,7 +177,6 @@ impl StepExecutor {
 
 #[cfg(test)]
 mod tests {
-    use crate::control::load_sharing::unloaded_warp;
     use crate::control::step_executor::actuation::{REACH_SPARE_M, reach_excess};
     use crate::control::step_executor::test_support::{
         all_contacts, config, contacts_without, ground, key, obs, robot, standing, step_path,
@@ -501,52 +488,5 @@ mod tests {
             z = tick(&mut ex, [0.5, 0.0, 0.0, 0.5]);
         }
         assert!(close(z, [0.0, -0.01, -0.01, 0.0]), "{z:?}");
-    }
-
-    #[test]
-    fn a_foot_waiting_to_lift_is_unloaded_first() {
-        // Waiting to lift FL (the guard), the loads equal on four feet (warp 0), the CoM at
-        // (−0.1, −0.1), inside the other three's triangle. The target is the warp with FL
-        // carrying nothing (`unloaded_warp`, negative here: front-right and rear-left take
-        // the weight), so front-right and rear-left are lowered at 0.25 m/s × the error
-        // per tick, the error being 0 − that warp.
-        let keys = step_path();
-        let feet = keys[0].feet;
-        let com = [-0.1, -0.1, 0.4];
-        let mut ex = StepExecutor::new(&robot(), config(), keys, ground());
-        let weight = robot().total_mass * 9.81;
-        let contacts = all_contacts(&feet);
-        let mut t = 0.0;
-        let mut tick = |ex: &mut StepExecutor| {
-            t += 0.01;
-            let mut o = obs(t, ex, &contacts, com);
-            o.wheel_loads = [0.25 * weight; 4];
-            ex.tick(&o, 0.01);
-            ex.foot_offset.map(|o| o[2])
-        };
-        let mut z = tick(&mut ex);
-        for _ in 0..100 {
-            if matches!(ex.mode, Mode::Guard { .. }) {
-                break;
-            }
-            z = tick(&mut ex);
-        }
-        assert!(matches!(ex.mode, Mode::Guard { .. }), "{:?}", ex.mode);
-        let target =
-            unloaded_warp(&feet.map(|f| [f[0], f[1]]), [com[0], com[1]], 0).expect("a triangle");
-        assert!(target < -0.1, "{target}");
-        let per_tick = 0.25 * (0.0 - target) * 0.01;
-        let before = z;
-        for _ in 0..10 {
-            z = tick(&mut ex);
-        }
-        assert!(matches!(ex.mode, Mode::Guard { .. }), "{:?}", ex.mode);
-        for leg in [Leg::FrontRight, Leg::RearLeft] {
-            let lowered = before[leg.index()] - z[leg.index()];
-            assert!((lowered - 10.0 * per_tick).abs() < 1e-12, "{leg:?}: {lowered}");
-        }
-        for leg in [Leg::FrontLeft, Leg::RearRight] {
-            assert!(z[leg.index()] >= before[leg.index()], "{leg:?}: {z:?}");
-        }
     }
 }

@@ -25,11 +25,10 @@
 use super::actuation::pairs_in_base;
 use super::interface::STANDARD_GRAVITY;
 use super::{Command, ExecFailure, Mode, Observation, StepExecutor, planar};
-use crate::control::load_sharing::{WARP_SIGN, measured_warp, target_warp, unloaded_warp};
+use crate::control::load_sharing::{WARP_SIGN, measured_warp, target_warp};
 use crate::control::path_follower::{FollowerStatus, PathFollower};
 use crate::geometry::wrap_angle;
 use crate::motion::kinematics::{Posture, interpolate};
-use crate::robot::Leg;
 
 /// How far a drive run moves a foot from its keyframe height to where its wheels rest,
 /// m: the foot cost's largest height difference within r_F (eq. 2), the most a wheel
@@ -100,7 +99,7 @@ impl StepExecutor {
     /// legs share is given back at `leg_release_speed_mps`.
     fn complied(&mut self, mut p: Posture, obs: &Observation, dt: f64) -> Posture {
         let mut extension = self.drive_extension;
-        if self.share_load(&p, obs, None, &mut extension, dt) {
+        if self.share_load(&p, obs, &mut extension, dt) {
             let shared = extension.iter().copied().fold(f64::INFINITY, f64::min);
             let back = shared.min(self.config.leg_release_speed_mps * dt);
             for e in &mut extension {
@@ -127,7 +126,6 @@ impl StepExecutor {
         &self,
         p: &Posture,
         obs: &Observation,
-        unloaded: Option<Leg>,
         extension: &mut [f64; 4],
         dt: f64,
     ) -> bool {
@@ -137,11 +135,8 @@ impl StepExecutor {
         let com = obs.base.inverse_transform([obs.com[0], obs.com[1]]);
         let carried =
             obs.wheel_loads.iter().sum::<f64>() >= 0.25 * self.robot.total_mass * STANDARD_GRAVITY;
-        let target = match unloaded {
-            Some(leg) => unloaded_warp(&feet, com, leg.index()),
-            None => target_warp(&feet, com),
-        };
-        let (true, Some(warp), Some(target)) = (carried, measured_warp(&obs.wheel_loads), target)
+        let (true, Some(warp), Some(target)) =
+            (carried, measured_warp(&obs.wheel_loads), target_warp(&feet, com))
         else {
             return false;
         };
