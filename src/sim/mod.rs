@@ -3,8 +3,9 @@
 //! [`Simulation`] compiles a scenario's world (`world`), reads the robot's description
 //! from the compiled model (`model`), and offers what controllers and monitors need in the
 //! project's own types: base pose, joint positions, the whole-robot CoM as MuJoCo computes
-//! it, which wheels touch the terrain and where, actuator targets, external pushes, ray
-//! casts for the sensed height map, and body poses for recordings.
+//! it, which wheels touch the terrain and where, the load on each wheel pair, actuator
+//! targets, external pushes, ray casts for the sensed height map, and body poses for
+//! recordings.
 
 pub mod model;
 pub mod world;
@@ -416,6 +417,28 @@ impl Simulation {
         std::array::from_fn(|i| xpos[self.legs[i].steer_body])
     }
 
+    /// The robot's geom in a contact between the robot and the terrain; `None` for any
+    /// other contact (robot with robot, terrain with terrain).
+    fn robot_geom_on_terrain(
+        &self,
+        c: &mujoco_rs::wrappers::mj_auxiliary::MjContact,
+    ) -> Option<usize> {
+        let (g1, g2) = (usize::try_from(c.geom1).ok()?, usize::try_from(c.geom2).ok()?);
+        match (self.terrain_geoms[g1], self.terrain_geoms[g2]) {
+            (true, false) => Some(g2),
+            (false, true) => Some(g1),
+            _ => None,
+        }
+    }
+
+    /// The leg index and the wheel (0 = left, 1 = right) of a wheel geom; `None` for any
+    /// other geom.
+    fn wheel_of(&self, geom: usize) -> Option<(usize, usize)> {
+        self.legs.iter().enumerate().find_map(|(leg, ids)| {
+            ids.wheel_geoms.iter().position(|&g| g == geom).map(|wheel| (leg, wheel))
+        })
+    }
+
     /// The wheels MuJoCo reports near the terrain now (within the wheels' contact `gap`,
     /// 4 mm: see `models/momaro.xml`), one entry per wheel in leg order, with the wheel's
     /// smallest distance. [`WheelContact::touching`] tells those in contact.
@@ -424,28 +447,20 @@ impl Simulation {
         // 1 mm of it (a wheel on a box edge has two contacts; both carry it).
         let mut best = [[(f64::INFINITY, [0.0; 3], 0u32); 2]; 4];
         for c in self.data.contact() {
-            let (g1, g2) = (c.geom1, c.geom2);
-            let (Ok(g1), Ok(g2)) = (usize::try_from(g1), usize::try_from(g2)) else { continue };
-            let (wheel, other) = if self.terrain_geoms[g2] { (g1, g2) } else { (g2, g1) };
-            if !self.terrain_geoms[other] {
+            let Some((leg, wheel)) = self.robot_geom_on_terrain(c).and_then(|g| self.wheel_of(g))
+            else {
                 continue;
-            }
-            for (ids, leg_best) in self.legs.iter().zip(best.iter_mut()) {
-                for (geom, (dist, sum, n)) in ids.wheel_geoms.iter().zip(leg_best.iter_mut()) {
-                    if *geom != wheel {
-                        continue;
-                    }
-                    if c.dist < *dist - TOUCHING_M {
-                        // A clearly nearer contact replaces the ones seen so far.
-                        (*dist, *sum, *n) = (c.dist, c.pos, 1);
-                    } else if c.dist <= *dist + TOUCHING_M {
-                        for (acc, p) in sum.iter_mut().zip(c.pos) {
-                            *acc += p;
-                        }
-                        *n += 1;
-                        *dist = dist.min(c.dist);
-                    }
+            };
+            let (dist, sum, n) = &mut best[leg][wheel];
+            if c.dist < *dist - TOUCHING_M {
+                // A clearly nearer contact replaces the ones seen so far.
+                (*dist, *sum, *n) = (c.dist, c.pos, 1);
+            } else if c.dist <= *dist + TOUCHING_M {
+                for (acc, p) in sum.iter_mut().zip(c.pos) {
+                    *acc += p;
                 }
+                *n += 1;
+                *dist = dist.min(c.dist);
             }
         }
         let mut out = Vec::with_capacity(8);
@@ -470,19 +485,12 @@ impl Simulation {
     pub fn wheel_loads(&self) -> [f64; 4] {
         let mut loads = [0.0; 4];
         for (k, c) in self.data.contact().iter().enumerate() {
-            let (Ok(g1), Ok(g2)) = (usize::try_from(c.geom1), usize::try_from(c.geom2)) else {
-                continue;
-            };
-            let wheel = match (self.terrain_geoms[g1], self.terrain_geoms[g2]) {
-                (true, false) => g2,
-                (false, true) => g1,
-                _ => continue,
-            };
-            let Some(i) = self.legs.iter().position(|l| l.wheel_geoms.contains(&wheel)) else {
+            let Some((leg, _)) = self.robot_geom_on_terrain(c).and_then(|g| self.wheel_of(g))
+            else {
                 continue;
             };
             if let Ok(f) = self.data.try_contact_force(k) {
-                loads[i] += f[0].max(0.0);
+                loads[leg] += f[0].max(0.0);
             }
         }
         loads
@@ -490,21 +498,13 @@ impl Simulation {
 
     /// Names of robot geoms other than wheels that touch terrain now: body-terrain collisions.
     pub fn body_terrain_collisions(&self) -> Vec<String> {
-        let wheels: Vec<usize> = self.legs.iter().flat_map(|l| l.wheel_geoms).collect();
         let mut names = Vec::new();
         for c in self.data.contact() {
-            let (Ok(g1), Ok(g2)) = (usize::try_from(c.geom1), usize::try_from(c.geom2)) else {
-                continue;
-            };
             if c.dist > TOUCHING_M {
                 continue;
             }
-            let robot_geom = match (self.terrain_geoms[g1], self.terrain_geoms[g2]) {
-                (true, false) => g2,
-                (false, true) => g1,
-                _ => continue,
-            };
-            if wheels.contains(&robot_geom) {
+            let Some(robot_geom) = self.robot_geom_on_terrain(c) else { continue };
+            if self.wheel_of(robot_geom).is_some() {
                 continue;
             }
             let body = self.model.geom_bodyid()[robot_geom];
