@@ -57,7 +57,8 @@ pub struct PlanOptions {
     pub probe_epsilon: Option<f64>,
     /// Whether ARA*'s probe is guided (`SearchParams::probe_guidance`: every other
     /// expansion ordered by the heuristic without its base-pose cost-to-go,
-    /// `HeuristicParts::guidance`). Default true.
+    /// `HeuristicParts::guidance`, and after `SearchParams::probe_greedy_after`
+    /// expansions without a path every third by that guidance alone). Default true.
     pub probe_guidance: bool,
     /// Expansions ARA*'s schedule may spend after its probe found a path
     /// (`SearchParams::schedule_max_expansions`): the probe's path is then the answer
@@ -963,8 +964,8 @@ pub struct BenchRow {
     pub first_cost: Option<f64>,
     /// Its cost over the optimum, % (`(first / optimum − 1) · 100`).
     pub first_over_optimum_pct: Option<f64>,
-    /// The bound ARA* certifies for it (`Solution::suboptimality_bound`, ε′ ≤ ε): its
-    /// cost is at most this times the optimum.
+    /// The bound ARA* certifies for it (`Solution::suboptimality_bound`): its cost is at
+    /// most this times the optimum.
     pub first_bound: Option<f64>,
     /// Best cost found within 1 s.
     pub cost_at_1s: Option<f64>,

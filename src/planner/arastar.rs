@@ -37,14 +37,23 @@
 //! the whole floor at every heading (1.6 M expansions) before it stepped onto a two-step
 //! flight its guidance (the same heuristic without that term) climbs in 140. Where the
 //! heuristic alone was the better guide, alternating costs expansions (a generated mixed
-//! course: 170 → 1,041). ε′ is certified as
-//! before, from the admissible heuristic over OPEN and INCONS, which holds whatever order
-//! the states were expanded in.
+//! course: 170 → 1,041). A probe that has reached no goal after
+//! `SearchParams::probe_greedy_after` expansions (20,000) adds a third list, ordered by
+//! the guidance alone (greedy best-first): where one edge costs more than ε times the
+//! heuristic's drop over it, both weighted lists expand every state keyed below its far
+//! side first. On a generated two-step flight whose every tread foothold lies near an
+//! edge (a step onto the first tread about 440, the heuristic's bound for it about 10),
+//! the two-list probe had no path after 930 k expansions (52 s); with the greedy list
+//! from its 20,000th expansion it has one at 20,267. Probes that reach a goal sooner
+//! are the two-list probe, unchanged. The greedy list ends the probe at the first goal
+//! reached, so that probe's path carries its certified ε′ alone, which may exceed ε
+//! (`Solution::suboptimality_bound`). ε′ is certified from the admissible heuristic over
+//! OPEN and INCONS, which holds whatever order the states were expanded in.
 //!
 //! Fixed point: ε is held in thousandths, and keys are `g·1000 + ε_milli·h`
 //! ([`super::Cost`] micro-units × 1000), so weighting is exact integer arithmetic.
 
-use super::engine::{ClosedPolicy, EPS_ONE, Engine, suboptimality_bound};
+use super::engine::{ClosedPolicy, EPS_ONE, Engine, certified_bound, suboptimality_bound};
 use super::params::eps_to_f64;
 use super::{Hooks, SearchError, SearchGraph, SearchParams, SearchResult, Termination};
 
@@ -90,7 +99,10 @@ pub fn arastar_with_hooks<G: SearchGraph>(
         if let Err(stop) = engine.improve_path() {
             return Ok(engine.finish(stop));
         }
-        if publish_best(&mut engine, &mut best).is_none() {
+        // A guided probe's greedy list, once it joined, ends it at the first goal it
+        // reaches, so its path carries the certified ε′ alone (engine module docs).
+        let certified = if engine.greedy_joined() { Bound::Certified } else { Bound::Epsilon };
+        if publish_best(&mut engine, &mut best, certified).is_none() {
             return Ok(engine.finish(Termination::NoPath));
         }
         if let Some(stop) = engine.limits.check_now() {
@@ -108,7 +120,7 @@ pub fn arastar_with_hooks<G: SearchGraph>(
             break stop;
         }
         // lines 04' / 10': ε′ and publish the current ε′-suboptimal solution
-        let Some(bound) = publish_best(&mut engine, &mut best) else {
+        let Some(bound) = publish_best(&mut engine, &mut best, Bound::Epsilon) else {
             break Termination::NoPath; // OPEN ran empty without reaching a goal
         };
         // line 05': while ε′ > 1
@@ -132,12 +144,22 @@ pub fn arastar_with_hooks<G: SearchGraph>(
     Ok(engine.finish(termination))
 }
 
+/// What bounds a search's solution.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Bound {
+    /// The weighted search's ε, or the certified ε′ if smaller (Likhachev et al. 2003).
+    Epsilon,
+    /// The certified ε′ alone: a search that may stop before its ε holds.
+    Certified,
+}
+
 /// After an `ImprovePath`: the path to the engine's goal becomes `best` unless `best` is
 /// cheaper, and `best` is published with its bound ε′ (Likhachev et al. 2003, Fig. 3,
 /// lines 04' and 10'), which is returned; `None` if no goal was reached.
 fn publish_best<G: SearchGraph>(
     engine: &mut Engine<'_, '_, G>,
     best: &mut Option<(Vec<G::State>, super::Cost)>,
+    kind: Bound,
 ) -> Option<f64> {
     let goal = engine.goal?;
     let lower = engine.lower_bound();
@@ -146,7 +168,10 @@ fn publish_best<G: SearchGraph>(
         *best = Some((path, cost));
     }
     let (path, cost) = best.clone()?;
-    let bound = suboptimality_bound(engine.eps, cost, lower);
+    let bound = match kind {
+        Bound::Epsilon => suboptimality_bound(engine.eps, cost, lower),
+        Bound::Certified => certified_bound(cost, lower),
+    };
     engine.publish(path, cost, bound);
     Some(bound)
 }

@@ -6,13 +6,21 @@
 //! being parked in INCONS (A* with re-opening, optimal for any admissible heuristic).
 //! The drivers in `astar` and `arastar` own the outer loop.
 //!
-//! **Guided search** (ARA*'s probe, `arastar` module docs): a second OPEN list ordered by
-//! `g + ε·guidance` ([`SearchGraph::heuristic_and_guidance`]) beside the first, and
-//! expansions taken from the two in turn (the alternation of Röger & Helmert, "The More,
-//! the Merrier: Combining Heuristic Estimators for Satisficing Planning", ICAPS 2010).
-//! Every OPEN state is in both lists and a state is closed whichever list it leaves by,
-//! so it is still expanded at most once per search; `g`, CLOSED, INCONS and the bound
-//! ε′ are the unguided search's, computed with the admissible heuristic.
+//! **Guided search** (ARA*'s probe, `arastar` module docs): beside OPEN (ordered by
+//! `g + ε·h`) a second list of the same states ordered by `g + ε·guidance`
+//! ([`SearchGraph::heuristic_and_guidance`]), and, once the search has made
+//! `SearchParams::probe_greedy_after` expansions without reaching a goal, a third,
+//! *greedy* one, ordered by the guidance alone (ties: the smaller `g`); expansions are
+//! taken from the lists in turn (the alternation of Röger & Helmert, "The More, the
+//! Merrier: Combining Heuristic Estimators for Satisficing Planning", ICAPS 2010). Every
+//! OPEN state is in every list and a state is closed whichever list it leaves by, so it
+//! is still expanded at most once per search; `g`, CLOSED, INCONS and the bound ε′ are
+//! the unguided search's, computed with the admissible heuristic. The greedy list crosses
+//! an edge dearer than ε times the heuristic's drop over it (a step onto a tread whose
+//! every foothold lies near an edge), where the weighted lists first expand every state
+//! keyed below its far side. It also ends the search as soon as a goal is reached (a
+//! goal's guidance is its list's smallest key), so the path of a search it joined is
+//! bounded by its ε′ alone, not by ε.
 
 use super::nodes::{Limits, NodeId, NodeStore, path_cost, weighted_key};
 use super::open_list::{Entry, OpenList};
@@ -38,8 +46,12 @@ pub(crate) struct Engine<'g, 'h, G: SearchGraph> {
     pub open: OpenList,
     /// The guidance-ordered OPEN list of a guided search (see the module docs).
     guide: Option<OpenList>,
-    /// The next expansion comes from `guide` (alternation).
-    guide_turn: bool,
+    /// The greedy list of a guided search: by guidance alone, ties by `g` (module docs).
+    greedy: Option<OpenList>,
+    /// Which list the next expansion comes from (0: OPEN, 1: `guide`, 2: `greedy`).
+    turn: u8,
+    /// Expansions after which a guided search without a goal adds `greedy`.
+    greedy_after: Option<u64>,
     /// ARA*'s INCONS: states whose `g` improved after they were closed this iteration.
     pub incons: Vec<NodeId>,
     succ: Vec<(G::State, Cost)>,
@@ -75,7 +87,9 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             store: NodeStore::new(params.max_states, dense_len),
             open: OpenList::new(),
             guide: None,
-            guide_turn: false,
+            greedy: None,
+            turn: 0,
+            greedy_after: params.probe_greedy_after,
             incons: Vec::new(),
             succ: Vec::with_capacity(32),
             limits: Limits::new(params.time_limit, params.max_expansions, hooks.cancel),
@@ -107,7 +121,8 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             if goal || !h.is_infinite() {
                 n.set_open(true);
                 let guidance = n.guidance;
-                push_open(&mut self.open, self.guide.as_mut(), id, Cost::ZERO, h, guidance, eps);
+                let lists = OpenLists::of(&mut self.open, &mut self.guide, &mut self.greedy);
+                lists.push(id, Cost::ZERO, h, guidance, eps);
             }
         }
     }
@@ -120,12 +135,14 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     }
 
     /// [`Engine::restart`] as a guided search (module docs) if `guided`: nodes then cache
-    /// the graph's guidance and OPEN has its second, guidance-ordered list.
+    /// the graph's guidance and OPEN has its guidance-ordered list (and its greedy one
+    /// from `SearchParams::probe_greedy_after` expansions on).
     pub fn restart_with(&mut self, start: G::State, eps: u64, guided: bool) {
         self.store.clear();
         self.store.guided = guided;
         self.guide = guided.then(OpenList::new);
-        self.guide_turn = false;
+        self.greedy = (guided && self.greedy_after == Some(0)).then(OpenList::new);
+        self.turn = 0;
         self.open = OpenList::new();
         self.incons.clear();
         self.goal = None;
@@ -149,11 +166,39 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
         n.in_open() && weighted_key(n.g, n.guidance, eps) == e.key
     }
 
+    /// Whether this search's greedy list has joined it (its path is then bounded by ε′
+    /// alone).
+    pub fn greedy_joined(&self) -> bool {
+        self.greedy.is_some()
+    }
+
+    /// Adds the greedy list to a guided search under way: every OPEN state, keyed by its
+    /// guidance.
+    fn start_greedy(&mut self) {
+        let mut greedy = OpenList::new();
+        for e in self.open.iter() {
+            if Self::is_valid(&self.store, e, self.eps) {
+                let n = self.store.get(e.node);
+                greedy.push(greedy_entry(e.node, n.g, n.guidance));
+            }
+        }
+        self.greedy = Some(greedy);
+    }
+
+    /// Whether a greedy-list entry is current: its state is still in OPEN with this `g`
+    /// (its guidance never changes).
+    #[inline]
+    fn is_valid_greedy(store: &NodeStore<G::State>, e: &Entry) -> bool {
+        let n = store.get(e.node);
+        n.in_open() && greedy_entry(e.node, n.g, n.guidance) == *e
+    }
+
     /// `ImprovePath()`: expand states in key order until the best goal's key is at most
     /// the smallest key in OPEN (Likhachev et al. 2003, Fig. 3, line 02), or OPEN is
     /// empty. `Err` with the reason when a limit stops it first. A guided search takes
-    /// every other state from its guidance-ordered list and also stops when the goal's
-    /// guidance key is at most that list's smallest.
+    /// its states from OPEN, the guidance-ordered and the greedy list in turn and also
+    /// stops when the goal's key in either of those is at most that list's smallest (for
+    /// the greedy list: once a goal is reached).
     pub fn improve_path(&mut self) -> Result<(), Termination> {
         let eps = self.eps;
         let iter = self.iter;
@@ -166,11 +211,24 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 .guide
                 .as_mut()
                 .and_then(|g| g.peek_valid(|e| Self::is_valid_guide(store, e, eps)));
+            if self.guide.is_some()
+                && self.greedy.is_none()
+                && self.goal.is_none()
+                && self.greedy_after.is_some_and(|n| self.expansions >= n)
+            {
+                self.start_greedy();
+            }
+            let store = &self.store;
+            let greedy_top = self
+                .greedy
+                .as_mut()
+                .and_then(|g| g.peek_valid(|e| Self::is_valid_greedy(store, e)));
             if let Some(goal) = self.goal {
                 let gn = self.store.get(goal);
                 // while fvalue(s_goal) > min_{s ∈ OPEN} fvalue(s)
                 if weighted_key(gn.g, gn.h, eps) <= top.key
                     || guided_top.is_some_and(|t| weighted_key(gn.g, gn.guidance, eps) <= t.key)
+                    || greedy_top.is_some_and(|t| gn.guidance.0 <= t.key)
                 {
                     return Ok(());
                 }
@@ -180,11 +238,12 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             }
             // line 03: remove s with the smallest fvalue from OPEN; CLOSED = CLOSED ∪ {s}
             // (a guided search: from each list in turn)
-            let from_guide = self.guide_turn && guided_top.is_some();
-            self.guide_turn = self.guide.is_some() && !self.guide_turn;
-            let id = match (from_guide, guided_top, &mut self.guide) {
-                (true, Some(t), Some(guide)) => {
-                    guide.pop_valid(|_| true);
+            let turn = self.turn;
+            let lists = 1 + u8::from(self.guide.is_some()) + u8::from(self.greedy.is_some());
+            self.turn = (turn + 1) % lists;
+            let id = match (turn, guided_top, greedy_top, &mut self.guide, &mut self.greedy) {
+                (1, Some(t), _, Some(list), _) | (2, _, Some(t), _, Some(list)) => {
+                    list.pop_valid(|_| true);
                     t.node
                 }
                 _ => {
@@ -253,7 +312,8 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 // lines 09–10: if s' ∉ CLOSED, insert/update s' in OPEN with fvalue(s')
                 tn.set_open(true);
                 let (h, guidance) = (tn.h, tn.guidance);
-                push_open(&mut self.open, self.guide.as_mut(), tid, ng, h, guidance, eps);
+                let lists = OpenLists::of(&mut self.open, &mut self.guide, &mut self.greedy);
+                lists.push(tid, ng, h, guidance, eps);
             }
         }
     }
@@ -306,6 +366,8 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     pub fn next_iteration(&mut self, new_eps: u64) {
         // Guidance orders one search (the probe); later iterations are the paper's.
         self.guide = None;
+        self.greedy = None;
+        self.turn = 0;
         self.store.guided = false;
         let old = self.eps;
         let mut entries = self.open.take_entries();
@@ -349,22 +411,53 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     }
 }
 
-/// Inserts node `id` (cost `g`, heuristic `h`, guidance `guidance`) into OPEN at ε
-/// `eps`, and into the guidance-ordered list of a guided search.
-#[inline]
-fn push_open(
-    open: &mut OpenList,
-    guide: Option<&mut OpenList>,
-    id: NodeId,
-    g: Cost,
-    h: Cost,
-    guidance: Cost,
-    eps: u64,
-) {
-    open.push(Entry { key: weighted_key(g, h, eps), h: h.0, node: id });
-    if let Some(guide) = guide {
-        guide.push(Entry { key: weighted_key(g, guidance, eps), h: guidance.0, node: id });
+/// OPEN and, in a guided search, its guidance-ordered and greedy lists.
+struct OpenLists<'a> {
+    open: &'a mut OpenList,
+    guide: Option<&'a mut OpenList>,
+    greedy: Option<&'a mut OpenList>,
+}
+
+impl<'a> OpenLists<'a> {
+    fn of(
+        open: &'a mut OpenList,
+        guide: &'a mut Option<OpenList>,
+        greedy: &'a mut Option<OpenList>,
+    ) -> Self {
+        Self { open, guide: guide.as_mut(), greedy: greedy.as_mut() }
     }
+
+    /// Inserts node `id` (cost `g`, heuristic `h`, guidance `guidance`) into every list
+    /// at ε `eps`.
+    #[inline]
+    fn push(self, id: NodeId, g: Cost, h: Cost, guidance: Cost, eps: u64) {
+        self.open.push(Entry { key: weighted_key(g, h, eps), h: h.0, node: id });
+        if let Some(guide) = self.guide {
+            guide.push(Entry { key: weighted_key(g, guidance, eps), h: guidance.0, node: id });
+        }
+        if let Some(greedy) = self.greedy {
+            greedy.push(greedy_entry(id, g, guidance));
+        }
+    }
+}
+
+/// A greedy-list entry: keyed by the guidance alone, ties broken by `g` (the entry's
+/// second field) and then by discovery.
+#[inline]
+fn greedy_entry(id: NodeId, g: Cost, guidance: Cost) -> Entry {
+    Entry { key: guidance.0, h: g.0, node: id }
+}
+
+/// `cost / lower_bound`, at least 1 (∞ for a lower bound of 0): the ε′ a path carries
+/// whatever order the search expanded in (for a consistent heuristic).
+pub(crate) fn certified_bound(cost: Cost, lower_bound: Cost) -> f64 {
+    if lower_bound >= cost {
+        return 1.0;
+    }
+    if lower_bound == Cost::ZERO {
+        return f64::INFINITY;
+    }
+    (cost.0 as f64 / lower_bound.0 as f64).max(1.0)
 }
 
 /// `min(ε, cost / lower_bound)`, at least 1.

@@ -14,11 +14,12 @@ pub struct Solution<S> {
     /// The path's cost: the sum of its edge costs as the graph reports them.
     pub cost: Cost,
     /// The heuristic weight ε of the search that produced it (1.0 for A*). The cost is
-    /// at most ε times the optimal cost (for a consistent heuristic).
+    /// at most ε times the optimal cost (for a consistent heuristic), except for ARA*'s
+    /// guided probe, which may stop sooner (`planner::engine`, "Guided search").
     pub epsilon: f64,
-    /// A tighter bound, `min(ε, cost / min_{s ∈ OPEN ∪ INCONS}(g(s) + h(s)))`
-    /// (Likhachev et al. 2003, Sec. 4): cost ≤ `suboptimality_bound` · optimal.
-    /// 1.0 means proven optimal.
+    /// The bound it carries, `min(ε, ε′)` with `ε′ = cost / min_{s ∈ OPEN ∪ INCONS}(g(s) +
+    /// h(s))` (Likhachev et al. 2003, Sec. 4), or ε′ alone for a guided probe's path (then
+    /// it may exceed ε): cost ≤ `suboptimality_bound` · optimal. 1.0 means proven optimal.
     pub suboptimality_bound: f64,
     /// Wall-clock time from the start of the search to this solution.
     pub time: Duration,

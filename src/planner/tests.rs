@@ -126,6 +126,54 @@ fn a_guided_probe_takes_the_route_its_guidance_shows() {
     assert_eq!((r.solutions[0].path.clone(), r.solutions[0].cost), (vec![S, A, G], units(6)));
 }
 
+/// S → A costs 100 and A → G 1 (the only way to the goal); S → P1 → … → P40 is a
+/// dead-end plateau of unit edges. h: 2 on S and the plateau, 1 on A, 0 on G
+/// (consistent). At ε = 10 the plateau's keys (k + 20) are all below A's (110).
+fn dear_edge() -> Table {
+    let mut edges = vec![(S, A, 100), (A, G, 1), (S, 4, 1)];
+    edges.extend((4..43).map(|p| (p, p + 1, 1)));
+    let mut h = vec![2; 44];
+    h[A as usize] = 1;
+    h[G as usize] = 0;
+    h[B as usize] = 2;
+    Table { edges, h, goal: G, guidance: None }
+}
+
+#[test]
+fn a_guided_probes_greedy_list_crosses_a_dear_edge_and_reports_its_true_bound() {
+    let p = SearchParams {
+        probe_epsilon: Some(10.0),
+        initial_epsilon: 3.0,
+        final_epsilon: 3.0,
+        schedule_max_expansions: Some(0),
+        probe_greedy_after: Some(0),
+        ..SearchParams::default()
+    };
+    // Guided: S from OPEN, P1 from the guidance's list (key 1 + 10·2 against A's 110),
+    // A from the greedy list (guidance 1 against P2's 2), which reaches G: three
+    // expansions. ε′ = 101 / min(g + h over OPEN) = 101 / (P2: 2 + 2), above ε = 10,
+    // which this search does not guarantee.
+    let r = arastar(&mut dear_edge(), S, &p).expect("valid params");
+    let probe = &r.solutions[0];
+    assert_eq!((probe.path.clone(), probe.cost, probe.expansions), (vec![S, A, G], units(101), 3));
+    assert!((probe.suboptimality_bound - 25.25).abs() < 1e-12, "{}", probe.suboptimality_bound);
+    // The greedy list joining after 10 expansions (S, P1…P9 by the weighted lists): P10
+    // from OPEN, P11 from the guidance's list, A from the greedy list: 13 expansions,
+    // ε′ = 101 / (P12: 12 + 2).
+    let later = SearchParams { probe_greedy_after: Some(10), ..p.clone() };
+    let r = arastar(&mut dear_edge(), S, &later).expect("valid params");
+    let probe = &r.solutions[0];
+    assert_eq!((probe.path.clone(), probe.expansions), (vec![S, A, G], 13));
+    assert!((probe.suboptimality_bound - 101.0 / 14.0).abs() < 1e-12);
+    // Unguided, the weighted search expands the whole plateau first (S, P1…P40, A) and
+    // its path carries ε (ε′ = 101 / 101 here: the goal alone is left in OPEN).
+    let r = arastar(&mut dear_edge(), S, &SearchParams { probe_guidance: false, ..p })
+        .expect("valid params");
+    let probe = &r.solutions[0];
+    assert_eq!((probe.cost, probe.expansions), (units(101), 42));
+    assert!((probe.suboptimality_bound - 1.0).abs() < 1e-12, "{}", probe.suboptimality_bound);
+}
+
 #[test]
 fn a_limit_on_the_schedule_leaves_the_probes_path() {
     // The probe expands S and A (2); the schedule may spend one expansion after it.
@@ -517,25 +565,34 @@ proptest! {
         (grid, start) in grid_strategy(),
         guidance in proptest::collection::vec(0u64..40, 196),
         probe in 3.5f64..60.0,
+        greedy_after in proptest::option::of(0u64..30),
     ) {
-        // Guidance of any size, unrelated to the costs: the probe's order changes, the
-        // bounds do not (ε′ from the admissible heuristic), and the schedule still ends
-        // at the optimum.
+        // Guidance of any size, unrelated to the costs: the probe's order changes, its
+        // bound ε′ (from the admissible heuristic) still holds, the schedule's paths keep
+        // their ε, and the schedule still ends at the optimum. (The probe's greedy list,
+        // when it joins, stops it at its first goal: its path's bound is ε′ alone.)
         let optimal = dijkstra(&mut grid.clone(), start);
         let mut g = Guided { grid: grid.clone(), guidance };
-        let p = SearchParams { probe_epsilon: Some(probe), ..eps_params(3.0, 0.5) };
+        let p = SearchParams {
+            probe_epsilon: Some(probe),
+            probe_greedy_after: greedy_after,
+            ..eps_params(3.0, 0.5)
+        };
         let r = arastar(&mut g, start, &p).expect("valid");
         let Some(opt) = optimal else {
             prop_assert_eq!(r.termination, Termination::NoPath);
             return Ok(());
         };
         prop_assert_eq!(r.termination, Termination::OptimalProven);
-        for sol in &r.solutions {
+        for (i, sol) in r.solutions.iter().enumerate() {
             assert_valid_path(&mut g.grid, start, sol);
-            let eps_milli = (sol.epsilon * 1000.0).round() as u128;
-            prop_assert!(u128::from(sol.cost.0) * 1000 <= eps_milli * u128::from(opt.0));
             prop_assert!(sol.cost.to_f64() <= sol.suboptimality_bound * opt.to_f64() * (1.0 + 1e-9));
-            prop_assert!(sol.suboptimality_bound >= 1.0 && sol.suboptimality_bound <= sol.epsilon);
+            prop_assert!(sol.suboptimality_bound >= 1.0);
+            if i > 0 {
+                let eps_milli = (sol.epsilon * 1000.0).round() as u128;
+                prop_assert!(u128::from(sol.cost.0) * 1000 <= eps_milli * u128::from(opt.0));
+                prop_assert!(sol.suboptimality_bound <= sol.epsilon);
+            }
         }
         prop_assert_eq!(r.best().map(|s| s.cost), Some(opt));
     }
