@@ -448,6 +448,38 @@ fn error_summary(scenario: &std::path::Path, e: &anyhow::Error) -> serde_json::V
     })
 }
 
+/// With `--json`, the object `plan` prints when it ends without a plan (stdout stays
+/// one JSON object whatever happens, as for `run`): `failure_kind` `no_path`,
+/// `planning_time_limit`, `motion_generation` (`--detailed`), `invalid_input` or `error`,
+/// and the message in `failure`. The exit code is the error's.
+fn print_plan_failure(json: bool, scenario: &std::path::Path, e: &anyhow::Error) {
+    if !json {
+        return;
+    }
+    let kind = e.chain().find_map(|c| {
+        if let Some(jobs::plan::PlanJobError::NoPath { termination, .. }) = c.downcast_ref() {
+            Some(match termination {
+                crate::planner::Termination::NoPath => "no_path",
+                _ => "planning_time_limit",
+            })
+        } else if let Some(jobs::detailed::DetailedJobError::Motion { .. }) = c.downcast_ref() {
+            Some("motion_generation")
+        } else {
+            None
+        }
+    });
+    let mut v = error_summary(scenario, e);
+    if let (Some(kind), Some(obj)) = (kind, v.as_object_mut()) {
+        obj.insert("failure_kind".into(), kind.into());
+    }
+    if let Some(obj) = v.as_object_mut() {
+        obj.remove("passed");
+        obj.remove("reached_goal");
+    }
+    // Printing can fail only on a closed stdout, where nobody reads the object.
+    let _ = print_json(&v);
+}
+
 fn robot(model: &std::path::Path) -> anyhow::Result<crate::robot::RobotDescription> {
     Ok(crate::sim::Simulation::robot_only(model)?.robot().clone())
 }
@@ -772,13 +804,18 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             Ok(true)
         }
         Command::Plan { scenario, planner, rerun, expansions, json, detailed: true, model } => {
-            let sc = load(&scenario)?;
-            let mut sim = crate::sim::Simulation::robot_only(&model.model)?;
             let opts = jobs::plan::PlanOptions { expansion_image: expansions, ..planner.options() };
-            let d = jobs::detailed::run(&sc, &mut sim, &opts).map_err(|e| match e {
-                jobs::detailed::DetailedJobError::Plan(p) => plan_error(p),
-                other => anyhow::Error::new(other),
-            })?;
+            let d = load(&scenario)
+                .and_then(|sc| {
+                    let mut sim = crate::sim::Simulation::robot_only(&model.model)?;
+                    let d = jobs::detailed::run(&sc, &mut sim, &opts).map_err(|e| match e {
+                        jobs::detailed::DetailedJobError::Plan(p) => plan_error(p),
+                        other => anyhow::Error::new(other),
+                    })?;
+                    Ok((sc, d))
+                })
+                .inspect_err(|e| print_plan_failure(json, &scenario, e));
+            let (sc, d) = d?;
             if let Some(path) = rerun {
                 jobs::detailed::record(&sc, &d, &path)
                     .with_context(|| format!("recording {}", path.display()))?;
@@ -801,10 +838,15 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             Ok(true)
         }
         Command::Plan { scenario, planner, rerun, expansions, json, detailed: false, model } => {
-            let sc = load(&scenario)?;
-            let robot = robot(&model.model)?;
             let opts = jobs::plan::PlanOptions { expansion_image: expansions, ..planner.options() };
-            let summary = jobs::plan::run(&sc, &robot, &opts).map_err(plan_error)?;
+            let planned = load(&scenario)
+                .and_then(|sc| {
+                    let robot = robot(&model.model)?;
+                    let summary = jobs::plan::run(&sc, &robot, &opts).map_err(plan_error)?;
+                    Ok((sc, robot, summary))
+                })
+                .inspect_err(|e| print_plan_failure(json, &scenario, e));
+            let (sc, robot, summary) = planned?;
             if let Some(path) = rerun {
                 jobs::plan_recording::record(&sc, &robot, &summary, &path)
                     .with_context(|| format!("recording {}", path.display()))?;

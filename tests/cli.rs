@@ -511,3 +511,40 @@ fn plan_draws_where_its_search_went_with_or_without_a_path() {
     assert!(!out.status.success() && stderr.contains("/nonexistent-dir/x.png"), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// `plan --json` of `args`: the exit code and the object on stdout.
+fn plan_json(args: &[&str]) -> (Option<i32>, serde_json::Value) {
+    let mut all = vec!["plan"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let out = momaro(&all);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let v = serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{args:?}: {e}: {stdout}"));
+    (out.status.code(), v)
+}
+
+#[test]
+fn plan_json_prints_one_object_whatever_happens() {
+    // No path (a closed room): exit 1, the failure's kind and message on stdout.
+    let room = common::root().join("scenarios/closed_room.toml");
+    let (code, v) = plan_json(&[room.to_str().unwrap()]);
+    assert_eq!((code, v["failure_kind"].as_str()), (Some(1), Some("no_path")), "{v}");
+    assert!(v["failure"].as_str().is_some_and(|f| f.contains("closed_room.toml")), "{v}");
+    // The time limit before any path: exit 1, `planning_time_limit`.
+    let stairs = common::root().join("scenarios/staircase.toml");
+    let (code, v) = plan_json(&[stairs.to_str().unwrap(), "--time-limit", "0.001"]);
+    assert_eq!((code, v["failure_kind"].as_str()), (Some(1), Some("planning_time_limit")), "{v}");
+    // Bad input, with and without `--detailed`: exit 2, `invalid_input` naming the file.
+    let dir = common::temp_dir("cli_plan_json");
+    let bad = dir.join("broken.toml");
+    std::fs::write(&bad, "[map]\nx_min = 0.0\n").unwrap();
+    for detailed in [false, true] {
+        let mut args = vec![bad.to_str().unwrap()];
+        if detailed {
+            args.push("--detailed");
+        }
+        let (code, v) = plan_json(&args);
+        assert_eq!((code, v["failure_kind"].as_str()), (Some(2), Some("invalid_input")), "{v}");
+        assert!(v["failure"].as_str().is_some_and(|f| f.contains("broken.toml")), "{v}");
+    }
+}
