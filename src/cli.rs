@@ -437,12 +437,24 @@ fn run_error(e: jobs::run::RunJobError) -> anyhow::Error {
 /// The JSON of a run that ended in an error rather than a summary: `run --json` always
 /// prints one object, with the failure's kind (`invalid_input` or `error`).
 fn error_summary(scenario: &std::path::Path, e: &anyhow::Error) -> serde_json::Value {
-    let kind = if e.chain().any(|c| c.is::<BadInput>()) { "invalid_input" } else { "error" };
+    let mut v = failure_object(scenario, e, input_or_error(e));
+    if let Some(obj) = v.as_object_mut() {
+        obj.insert("passed".into(), false.into());
+        obj.insert("reached_goal".into(), false.into());
+    }
+    v
+}
+
+/// `invalid_input` for bad input (exit code 2), else `error`.
+fn input_or_error(e: &anyhow::Error) -> &'static str {
+    if e.chain().any(|c| c.is::<BadInput>()) { "invalid_input" } else { "error" }
+}
+
+/// The scenario, its path, the failure's kind and its message.
+fn failure_object(scenario: &std::path::Path, e: &anyhow::Error, kind: &str) -> serde_json::Value {
     serde_json::json!({
         "scenario": scenario.file_stem().map(|s| s.to_string_lossy().into_owned()),
         "path": scenario.display().to_string(),
-        "passed": false,
-        "reached_goal": false,
         "failure_kind": kind,
         "failure": format!("{e:#}"),
     })
@@ -468,14 +480,7 @@ fn print_plan_failure(json: bool, scenario: &std::path::Path, e: &anyhow::Error)
             None
         }
     });
-    let mut v = error_summary(scenario, e);
-    if let (Some(kind), Some(obj)) = (kind, v.as_object_mut()) {
-        obj.insert("failure_kind".into(), kind.into());
-    }
-    if let Some(obj) = v.as_object_mut() {
-        obj.remove("passed");
-        obj.remove("reached_goal");
-    }
+    let v = failure_object(scenario, e, kind.unwrap_or_else(|| input_or_error(e)));
     // Printing can fail only on a closed stdout, where nobody reads the object.
     let _ = print_json(&v);
 }

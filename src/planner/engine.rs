@@ -203,14 +203,6 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
         let eps = self.eps;
         let iter = self.iter;
         loop {
-            let store = &self.store;
-            let Some(top) = self.open.peek_valid(|e| Self::is_valid(store, e, eps)) else {
-                return Ok(()); // OPEN = ∅
-            };
-            let guided_top = self
-                .guide
-                .as_mut()
-                .and_then(|g| g.peek_valid(|e| Self::is_valid_guide(store, e, eps)));
             if self.guide.is_some()
                 && self.greedy.is_none()
                 && self.goal.is_none()
@@ -219,6 +211,13 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 self.start_greedy();
             }
             let store = &self.store;
+            let Some(top) = self.open.peek_valid(|e| Self::is_valid(store, e, eps)) else {
+                return Ok(()); // OPEN = ∅
+            };
+            let guided_top = self
+                .guide
+                .as_mut()
+                .and_then(|g| g.peek_valid(|e| Self::is_valid_guide(store, e, eps)));
             let greedy_top = self
                 .greedy
                 .as_mut()
@@ -462,14 +461,7 @@ pub(crate) fn certified_bound(cost: Cost, lower_bound: Cost) -> f64 {
 
 /// `min(ε, cost / lower_bound)`, at least 1.
 pub(crate) fn suboptimality_bound(eps: u64, cost: Cost, lower_bound: Cost) -> f64 {
-    let e = eps_to_f64(eps);
-    if lower_bound >= cost {
-        return 1.0;
-    }
-    if lower_bound == Cost::ZERO {
-        return e;
-    }
-    (cost.0 as f64 / lower_bound.0 as f64).clamp(1.0, e)
+    certified_bound(cost, lower_bound).min(eps_to_f64(eps))
 }
 
 /// ε = 1 in milli-units.
