@@ -542,17 +542,17 @@ impl<'a> Expander<'a> {
         [self.cur.base_position[0], self.cur.base_position[1]]
     }
 
-    /// The alignment of one step candidate before its base shift: the partner wheel
-    /// toward the centre (`wheel_fraction` of the way) and the roll (`roll_fraction`),
-    /// at leg height `height`. Candidates that differ only in their shift share it.
-    fn step_alignment(
+    /// The longitudinal part of a step candidate's alignment: the partner wheel toward
+    /// the centre (`wheel_fraction` of the way) at leg height `height`, and the support
+    /// it leaves for the roll ([`Self::roll_alignment`]). Candidates that differ only in
+    /// their roll or shift share it.
+    fn wheel_alignment(
         &mut self,
         leg: Leg,
         post_foot: [f64; 3],
         height: f64,
         wheel_fraction: f64,
-        roll_fraction: f64,
-    ) -> Result<Alignment, String> {
+    ) -> Result<WheelAlignment, String> {
         let o = *self.o;
         let i = leg.index();
         let j = leg.same_side_partner().index();
@@ -633,9 +633,41 @@ impl<'a> Expander<'a> {
         let z_rot = support.iter().map(|f| f[2]).sum::<f64>() / 3.0;
         let left = (lateral(moved[0]) + lateral(moved[2])) / 2.0;
         let right = (lateral(moved[1]) + lateral(moved[3])) / 2.0;
-        let b = (left - right).abs();
+        let width = (left - right).abs();
         let p1 = self.standing(moved, all, xy, yaw, pitch, 0.0, height, ground);
-        let mut com = self.com_of(&p1)?;
+        let com = self.com_of(&p1)?;
+        Ok(WheelAlignment {
+            height,
+            stance,
+            d,
+            wanted,
+            moved,
+            stc,
+            rot: [y_rot, z_rot],
+            width,
+            com,
+        })
+    }
+
+    /// A step candidate's alignment before its base shift: `wheel`'s
+    /// ([`Self::wheel_alignment`]), then the roll that takes the CoM `roll_fraction` of
+    /// the way sideways to the support centroid (eqs. 6–8, iterated with the CoM model).
+    fn roll_alignment(
+        &mut self,
+        wheel: &WheelAlignment,
+        roll_fraction: f64,
+    ) -> Result<Alignment, String> {
+        let o = *self.o;
+        let yaw = self.cur.base_rpy[2];
+        let (s, c) = yaw.sin_cos();
+        let along = |f: [f64; 3]| c * f[0] + s * f[1];
+        let lateral = |f: [f64; 3]| -s * f[0] + c * f[1];
+        let xy = self.xy();
+        let all = [true; 4];
+        let WheelAlignment { height, stance, d, wanted, moved, stc, rot, width: b, mut com } =
+            *wheel;
+        let StepStance { pitch, ground, .. } = stance;
+        let [y_rot, z_rot] = rot;
         let y_target = lateral(com) + roll_fraction * (lateral(stc) - lateral(com));
         let mut roll = 0.0;
         for _ in 0..5 {
@@ -818,9 +850,10 @@ impl<'a> Expander<'a> {
             }
             StepSearch::Full => Box::new(full_candidates(&heights.collect::<Vec<_>>()).into_iter()),
         };
-        // Candidates that differ only in their shift share their alignment, and those
-        // whose sequences come out the same (no shift where the wheel was not hindered)
-        // are checked once.
+        // Candidates that differ only in their shift share their alignment, those that
+        // differ only in their roll too its wheel move, and those whose sequences come out
+        // the same (no shift where the wheel was not hindered) are checked once.
+        let mut wheels: Vec<((f64, f64), Result<WheelAlignment, String>)> = Vec::new();
         let mut alignments: Vec<(AlignmentKey, Result<Alignment, String>)> = Vec::new();
         let mut tried: Vec<Vec<Planned>> = Vec::new();
         // Early keyframes that failed (candidates can share them).
@@ -841,7 +874,15 @@ impl<'a> Expander<'a> {
             let aligned = match alignments.iter().find(|(k, _)| *k == key) {
                 Some((_, a)) => a.clone(),
                 None => {
-                    let a = self.step_alignment(leg, post_foot, h, wf, rf);
+                    let wheel = match wheels.iter().find(|(k, _)| *k == (h, wf)) {
+                        Some((_, w)) => w.clone(),
+                        None => {
+                            let w = self.wheel_alignment(leg, post_foot, h, wf);
+                            wheels.push(((h, wf), w.clone()));
+                            w
+                        }
+                    };
+                    let a = wheel.and_then(|w| self.roll_alignment(&w, rf));
                     alignments.push((key, a.clone()));
                     a
                 }
@@ -1111,7 +1152,30 @@ struct EarlyKeyframes {
 /// What a step candidate's alignment depends on: leg height, wheel and roll fractions.
 type AlignmentKey = (f64, f64, f64);
 
-/// A step candidate's alignment before its base shift ([`Expander::step_alignment`]).
+/// The longitudinal part of a step candidate's alignment ([`Expander::wheel_alignment`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct WheelAlignment {
+    /// Leg height of the standing rule, m.
+    height: f64,
+    /// How the step is stood ([`crate::motion::standing::StandingRule::step_stance`]).
+    stance: StepStance,
+    /// How far the partner wheel moves toward the centre, m.
+    d: f64,
+    /// How far longitudinal alignment wanted it to move, m.
+    wanted: f64,
+    /// The feet with the partner moved.
+    moved: [[f64; 3]; 4],
+    /// The support triangle's centroid (x, y, 0).
+    stc: [f64; 3],
+    /// The centre of rotation of the roll (y'_rot, z'_rot) (eq. 6).
+    rot: [f64; 2],
+    /// The footprint's width b (eq. 8), m.
+    width: f64,
+    /// The CoM standing with the partner moved, unrolled.
+    com: [f64; 3],
+}
+
+/// A step candidate's alignment before its base shift ([`Expander::roll_alignment`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Alignment {
     /// Leg height of the standing rule, m.

@@ -130,21 +130,21 @@ impl StandingRule {
             let i = leg.index();
             let h = robot.hips[i];
             let LegChain { knee, ankle, .. } = legs.chains[i];
+            // The chain's points in the world: the base transform is affine, so the
+            // samples between them are the world points' interpolation (three
+            // transforms a leg, not eight).
             let chain = [
-                [h[0], h[2]],
-                [h[0] + knee[0], h[2] + knee[1]],
-                [h[0] + ankle[0], h[2] + ankle[1]],
-            ];
+                [h[0], h[1], h[2]],
+                [h[0] + knee[0], h[1], h[2] + knee[1]],
+                [h[0] + ankle[0], h[1], h[2] + ankle[1]],
+            ]
+            .map(|b| apply(r, legs.base_position, b));
             for seg in chain.windows(2) {
                 // A quarter segment apart, far end included (the hip never dips).
                 for k in 1..=4 {
                     let t = f64::from(k) / 4.0;
-                    let b = [
-                        seg[0][0] + (seg[1][0] - seg[0][0]) * t,
-                        h[1],
-                        seg[0][1] + (seg[1][1] - seg[0][1]) * t,
-                    ];
-                    let w = apply(r, legs.base_position, b);
+                    let w: [f64; 3] =
+                        std::array::from_fn(|c| seg[0][c] + (seg[1][c] - seg[0][c]) * t);
                     let Some(top) = terrain.height_at_cell(w[0], w[1]) else { continue };
                     if w[2] - top < self.leg_clearance_m {
                         return Err(PostureError::LegCollision { leg, clearance: w[2] - top });

@@ -98,10 +98,11 @@ pub fn leg_ik(
 /// which a posture computes once for its four legs. The knee comes without trigonometry:
 /// it lies `l1` from the hip and `l2` from the ankle, on the side of the hip–ankle line
 /// its leg's knees point to, so it is the hip–ankle direction turned by γ with
-/// cos γ = (l1² + d² − l2²)/(2·l1·d), d the hip–ankle distance; the hip angle is that
-/// direction's angle β less γ. The knee equals [`knee_and_ankle`] of the joint angles to
-/// rounding (about 1e-16 m), as the angles do the textbook solution's (q1 = β −
-/// atan2(l2·sin q2, l1 + l2·cos q2)).
+/// cos γ = (l1² + d² − l2²)/(2·l1·d), d the hip–ankle distance; the hip angle is the
+/// knee's direction from the hip (β less γ, β the hip–ankle direction's angle, in one
+/// arctangent: the IK runs in every posture check the planner makes). The knee equals
+/// [`knee_and_ankle`] of the joint angles to rounding (about 1e-16 m), as the angles do
+/// the textbook solution's (q1 = β − atan2(l2·sin q2, l1 + l2·cos q2)).
 ///
 /// # Errors
 /// [`IkError`] as [`leg_ik`].
@@ -135,8 +136,18 @@ pub fn leg_chain(
         // radius l1 solves it; the thigh along β.
         (1.0, 0.0)
     };
-    let beta = (-ankle[0]).atan2(-ankle[1]);
-    let q1 = beta - sin_g.atan2(cos_g);
+    let (q1, knee) = if d > 0.0 {
+        // The unit vector hip → ankle turned by γ; the thigh's angle from straight down
+        // is the hip angle (one arctangent where β − γ takes two).
+        let e = [ankle[0] / d, ankle[1] / d];
+        let knee = [l1 * (cos_g * e[0] - sin_g * e[1]), l1 * (sin_g * e[0] + cos_g * e[1])];
+        ((-knee[0]).atan2(-knee[1]), knee)
+    } else {
+        // No direction to turn: the thigh along β, the hip–ankle direction's angle.
+        let q1 = (-ankle[0]).atan2(-ankle[1]);
+        let a = u(q1);
+        (q1, [l1 * a[0], l1 * a[1]])
+    };
     let q3 = -pitch - q1 - q2;
     let q = [q1, q2, q3];
     for (k, name) in ["hip", "knee", "ankle"].iter().enumerate() {
@@ -151,15 +162,6 @@ pub fn leg_chain(
             });
         }
     }
-    let knee = if d > 0.0 {
-        // The unit vector hip → ankle turned by γ.
-        let e = [ankle[0] / d, ankle[1] / d];
-        [l1 * (cos_g * e[0] - sin_g * e[1]), l1 * (sin_g * e[0] + cos_g * e[1])]
-    } else {
-        // No direction to turn: the thigh at the hip angle.
-        let a = u(q1);
-        [l1 * a[0], l1 * a[1]]
-    };
     Ok(LegChain { joints: q, knee, ankle })
 }
 
