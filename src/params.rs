@@ -33,8 +33,8 @@ pub struct Params {
     /// (the default) or the wheel pair's own contact footprint at the foot's heading
     /// (see [`FootModel`] and `cost::foot`).
     pub foot_model: FootModel,
-    /// How steps are prepared and pre-checked (see [`StepModel`]): `paper` (the
-    /// default) or `stairs`.
+    /// Which manoeuvres prepare steps (see [`StepModel`]): `paper` (the default) or
+    /// `stairs`.
     pub step_model: StepModel,
 
     /// Body cost weight k2 on missing clearance under the base (eq. 3).
@@ -118,15 +118,6 @@ pub struct Params {
     /// Smallest longitudinal gap the displaced wheel pair keeps to the stepping foot, m.
     /// Ours: 0.3 m (two wheel pairs' length with room to spare).
     pub wheel_gap_m: f64,
-    /// Planner's support check for a step: the signed distance of a CoM estimate to the
-    /// support triangle of the other three feet (the partner wheel moved toward the
-    /// centre as the generator would) must be at least this, m. Base roll (eqs. 6–8) and a
-    /// base shift take the CoM the rest of the way. Ours: 0.055 m, the generator's 3 cm
-    /// plus 2.5 cm for what the estimate leaves out (the stepping leg folding as its foot
-    /// lifts, the stance legs' compliance); at 0.04 m a staircase rear step passed the
-    /// check and failed the generator by 3 mm. The paper leaves stability to the
-    /// generator, whose failures it does not report.
-    pub step_support_margin_m: f64,
 
     /// ARA*: initial heuristic weight (Sec. VIII): 3.0.
     pub arastar_initial_epsilon: f64,
@@ -176,7 +167,6 @@ impl Default for Params {
             lift_margin_reserve_m: 0.03,
             max_wheel_to_centre_m: 0.45,
             wheel_gap_m: 0.3,
-            step_support_margin_m: 0.055,
             arastar_initial_epsilon: 3.0,
             arastar_epsilon_decay: 0.5,
             arastar_probe_epsilon: 50.0,
@@ -210,25 +200,25 @@ impl FootModel {
     }
 }
 
-/// How the planner prepares and pre-checks steps, written `step_model = "paper"` or
-/// `step_model = "stairs"` in a scenario's `[params]`.
+/// Which manoeuvres prepare a step, written `step_model = "paper"` or
+/// `step_model = "stairs"` in a scenario's `[params]`. With either, a step is planned
+/// only where the motion generator's own check expands it (`locomotion::hybrid`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StepModel {
-    /// The paper's manoeuvres (Sec. V), the front feet never behind neutral, and a
-    /// step's support pre-checked as a margin of `step_support_margin_m` at the
-    /// unaligned stance. Fast on the paper's scenarios; it finds no path on stairs whose
-    /// treads are shorter than the robot's hip spacing.
+    /// The paper's manoeuvres (Sec. V), the front feet never behind neutral. Fast on the
+    /// paper's scenarios; it climbs three building-code steps but finds no path up a
+    /// flight longer than the robot's feet span (four or more).
     #[default]
     Paper,
     /// Adds the rear-step approach (a base shift past the front feet's neutral, where
     /// their way ahead is blocked, so a rear foot reaches a riser while the front feet
     /// stand on a short tread), the climb shift (on a flight longer than the robot, the
     /// base forward past the front feet's neutral so a rear foot can step and the front
-    /// legs reach the next tread), and pre-checks a step's support at the generator's
-    /// lift keyframe with its alignments (`locomotion::hybrid`), instead of the tuned
-    /// margin. Climbs and descends building-code stairs; plans the paper's staircase
-    /// about 6× slower, as more steps are feasible.
+    /// legs reach the next tread), and the generator's partner wheel stops short of
+    /// where its leg leaves reach before a step (with `paper` such a step fails).
+    /// Climbs and descends building-code stairs; plans the paper's staircase slower, as
+    /// more manoeuvres are open.
     Stairs,
 }
 
@@ -304,13 +294,6 @@ impl Params {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(InvalidParam { name, value, reason: "must be a finite number >= 0" });
             }
-        }
-        if !self.step_support_margin_m.is_finite() {
-            return Err(InvalidParam {
-                name: "step_support_margin_m",
-                value: self.step_support_margin_m,
-                reason: "must be a finite number",
-            });
         }
         if self.orientations < 4 || !self.orientations.is_multiple_of(4) {
             return Err(InvalidParam {

@@ -206,23 +206,37 @@ fn staircase_climbs_then_takes_the_bar_between_its_legs() {
 }
 
 #[test]
-fn stairs_shorter_than_the_robot_need_the_stairs_step_model() {
-    // The paper's step model keeps the front feet ahead of neutral, so the feet of one
-    // side stay a hip spacing (0.7 m) apart: on 0.29 m treads no footprint puts a rear
-    // foot at a riser while the front feet stand on a tread, and the search ends with
-    // "no path" after exhausting the map. The stairs model plans it, up and down.
-    let mut s = scenario("stairs_indoor");
-    for name in ["stairs_indoor", "stairs_descent"] {
-        let p = plan(&scenario(name), &first_solution());
-        check_solutions(&p);
-        assert!(steps(&p).len() >= 12, "{name}: every foot climbs three steps");
-    }
+fn flights_longer_than_the_robot_need_the_stairs_step_model() {
+    // The paper's step model keeps the front feet ahead of neutral. On a flight longer
+    // than the robot's 0.8 m feet span (four steps of 0.17 m on 0.29 m treads) the front
+    // feet then stand on a tread they cannot roll along while the rear feet climb, and no
+    // rear foot can lift: the search ends with "no path" after exhausting the map. The
+    // stairs model's climb shift plans it.
+    let mut s = scenario("stairs_stairwell");
+    let p = plan(&s, &first_solution());
+    check_solutions(&p);
+    assert!(steps(&p).len() >= 16, "every foot climbs four steps");
     s.params.step_model = StepModel::Paper;
-    s.map.x_max = 3.0; // a smaller map: the exhaustive search ends sooner
-    s.goal.x = 1.6;
+    s.map.x_max = 2.7; // a smaller map, the goal on the landing: the search ends sooner
+    s.goal.x = 2.0;
     match run(&s, &robot(), &first_solution()) {
         Err(PlanJobError::NoPath { .. }) => {}
         other => panic!("expected no path with the paper's step model: {other:?}"),
+    }
+    // Three steps are climbed with either model, and descended with the stairs model.
+    // With the paper's, the rear steps need the generator's alignment (the partner wheel,
+    // the roll, a base shift): the planner's CoM-in-triangle pre-check turned them all
+    // away, although the generator expands them, and answered "no path" here.
+    for (name, model) in [
+        ("stairs_indoor", StepModel::Stairs),
+        ("stairs_indoor", StepModel::Paper),
+        ("stairs_descent", StepModel::Stairs),
+    ] {
+        let mut s = scenario(name);
+        s.params.step_model = model;
+        let p = plan(&s, &first_solution());
+        check_solutions(&p);
+        assert!(steps(&p).len() >= 12, "{name}, {model:?}: every foot climbs three steps");
     }
 }
 

@@ -462,6 +462,55 @@ mod hybrid {
     }
 
     #[test]
+    fn rear_steps_the_generator_expands_are_offered() {
+        // The paper's platform (0.2 m), neutral footprint, front feet on it, rear feet
+        // 0.16 m before its edge (`scenarios/platform.toml` at x = 4.1875). Every rear
+        // foothold needs the generator's alignment (partner wheel, roll, base shift): at
+        // the unaligned stance the CoM lies within 5.5 cm of the support triangle's edge.
+        // The planner's CoM-in-triangle pre-check turned all of them away, though the
+        // generator expands them, and offered no rear step here.
+        let maps = platform_maps(0.2);
+        let robot = robot();
+        let mut g = graph(&maps, LatticeState::new(0, 0, 0));
+        let s = state_at(&g, 1.1875, 0.0);
+        let steps = step_edges(&mut g, s);
+        let legs: Vec<_> = steps.iter().filter_map(|(_, _, m)| m.leg).collect();
+        assert!(legs.contains(&Leg::RearLeft) && legs.contains(&Leg::RearRight), "{legs:?}");
+        // Each offered step is one the generator expands from the rule's stance.
+        let motion = g.config().motion;
+        let rule = motion.standing;
+        let pose = g.lattice().pose(s);
+        let ground = |f: [f64; 2]| [f[0], f[1], maps.height_at(f[0], f[1]).expect("ground")];
+        let world = g.feet(s).expect("feet").map(ground);
+        let xy = [pose.x, pose.y];
+        let (pre, _) =
+            rule.stand(&robot, maps.leg_terrain(), world, xy, pose.theta).expect("stands");
+        for (t, _, m) in &steps {
+            let leg = m.leg.expect("a step's leg");
+            let post = ground(g.feet(*t).expect("feet")[leg.index()]);
+            let heights = rule.step_heights(
+                &robot,
+                maps.heights(),
+                maps.leg_terrain(),
+                world,
+                leg.index(),
+                post,
+                xy,
+                pose.theta,
+            );
+            let mut model = crate::motion::standing::EstimatedCom { robot: &robot };
+            let mut check = crate::motion::expand::ManoeuvreCheck {
+                robot: &robot,
+                maps: &maps,
+                model: &mut model,
+                options: &motion,
+            };
+            let r = check.step(pre, leg, post, heights);
+            assert!(r.is_ok(), "{leg:?} to {post:?}: {r:?}");
+        }
+    }
+
+    #[test]
     fn front_steps_onto_a_block_taller_than_the_two_tallest_stances_allow() {
         // A front foot onto 0.24 m: at the two tallest leg heights of the shared rule
         // (0.35 and 0.34 m for this step) the stance rolled toward the support triangle
