@@ -286,6 +286,23 @@ mod hybrid {
         HybridConfig::new(&Params::default(), &robot(), Neighbourhood::N16)
     }
 
+    /// Runs one of the generator's own checks (`check`) as the planner does: the CoM
+    /// estimate, the planner's margins (`options`).
+    fn with_generator<T>(
+        robot: &RobotDescription,
+        maps: &CostMaps,
+        options: &crate::motion::expand::MotionOptions,
+        check: impl FnOnce(&mut crate::motion::expand::ManoeuvreCheck<'_>) -> T,
+    ) -> T {
+        let mut model = crate::motion::standing::EstimatedCom { robot };
+        check(&mut crate::motion::expand::ManoeuvreCheck {
+            robot,
+            maps,
+            model: &mut model,
+            options,
+        })
+    }
+
     /// The abstract steps among `s`'s successors, in the graph's order.
     fn step_edges(
         g: &mut HybridGraph<'_>,
@@ -498,14 +515,7 @@ mod hybrid {
                 xy,
                 pose.theta,
             );
-            let mut model = crate::motion::standing::EstimatedCom { robot: &robot };
-            let mut check = crate::motion::expand::ManoeuvreCheck {
-                robot: &robot,
-                maps: &maps,
-                model: &mut model,
-                options: &motion,
-            };
-            let r = check.step(pre, leg, post, heights);
+            let r = with_generator(&robot, &maps, &motion, |c| c.step(pre, leg, post, heights));
             assert!(r.is_ok(), "{leg:?} to {post:?}: {r:?}");
         }
     }
@@ -691,14 +701,7 @@ mod hybrid {
                     continue;
                 }
                 let to = g.feet(u).expect("feet")[leg.index()];
-                let mut model = crate::motion::standing::EstimatedCom { robot: &robot };
-                let mut check = crate::motion::expand::ManoeuvreCheck {
-                    robot: &robot,
-                    maps: &maps,
-                    model: &mut model,
-                    options: &motion,
-                };
-                let r = check.wheel_move(pre, leg, to);
+                let r = with_generator(&robot, &maps, &motion, |c| c.wheel_move(pre, leg, to));
                 assert!(r.is_ok(), "{o:?}: {leg:?} to {:?}: {r:?}", g.offsets(u));
                 checked += 1;
             }
