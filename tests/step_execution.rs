@@ -26,6 +26,11 @@ fn plan_options() -> PlanOptions {
     PlanOptions { time_limit_s: 600.0, final_epsilon: Some(3.0), ..PlanOptions::default() }
 }
 
+/// The probe's path, as `plan --schedule-expansions 0` finds it.
+fn probe_path() -> PlanOptions {
+    PlanOptions { schedule_expansions: Some(0), ..plan_options() }
+}
+
 /// Where an executed prefix of a plan ends.
 #[derive(Debug, Clone, Copy)]
 enum End {
@@ -240,8 +245,13 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
 
 /// The whole mission (`momaro run`): plan, expand, execute with replanning.
 fn run_whole(name: &str) -> RunSummary {
+    run_whole_with(name, plan_options())
+}
+
+/// [`run_whole`] with planner options `plan`.
+fn run_whole_with(name: &str, plan: PlanOptions) -> RunSummary {
     let sc = common::scenario(name);
-    let s = run::run(&sc, &RunOptions::new(plan_options(), common::model())).expect("run");
+    let s = run::run(&sc, &RunOptions::new(plan, common::model())).expect("run");
     println!(
         "{name}: goal {:.3} m / {:.1}°, {} of {} steps, min margin {:.3} m, max pitch {:.1}°, wall {:.1} s, RTF {:.1}",
         s.goal_position_error_m,
@@ -349,7 +359,10 @@ fn steep_stairs_descent_whole_mission_in_closed_loop() {
 
 #[test]
 fn staircase_whole_mission_in_closed_loop_pitches_with_the_stairs() {
-    let s = run_whole("staircase");
+    // The probe's path: what `momaro run` executes here, its schedule stopping at
+    // `RUN_SCHEDULE_EXPANSIONS` short of ε = 3 (1.5M expansions); the run without
+    // spending them.
+    let s = run_whole_with("staircase", probe_path());
     // Treads 0.12 m high and 0.7 m deep, the feet 0.7 m apart: the front feet stand one
     // tread above the rear ones while driving and up to two while stepping. The base
     // pitches by 70 % of that slope (Sec. VI-B): at least 70 % of one tread's slope, at
@@ -372,10 +385,11 @@ fn an_aborted_step_returns_to_the_driving_posture_and_replans() {
     // there (once). The planner asks the same threshold of its steps, so the replan finds
     // no path (or, were one found, its first step would be aborted again with no replan
     // left). Either way the run stops, reported.
+    // The probe's path: any path's first step is aborted.
     let opts = RunOptions {
         max_replans: 1,
         replan_time_limit_s: 30.0,
-        ..RunOptions::new(plan_options(), common::model())
+        ..RunOptions::new(probe_path(), common::model())
     };
     let (s, sim) = execute_unliftable("staircase", opts);
     let sc = common::scenario("staircase");
@@ -425,16 +439,15 @@ fn a_generated_step_down_keeps_its_knees_off_the_edge() {
 #[test]
 fn a_generated_block_above_the_two_tallest_stances_is_climbed_in_closed_loop() {
     let sc = common::generated(momaro::scenario::generate::Class::UpAndOver, 52);
-    let plan = PlanOptions { schedule_expansions: Some(0), ..plan_options() };
-    let s = run::run(&sc, &RunOptions::new(plan, common::model())).expect("run");
+    let s = run::run(&sc, &RunOptions::new(probe_path(), common::model())).expect("run");
     assert!(s.steps_planned >= 8, "{s:#?}");
     assert_clean(&s);
     assert!(s.passed, "{s:#?}");
 }
 
-/// Plans scenario `name` with the paper's lift threshold and executes it with one no
-/// posture meets (30 cm, for the executor only), so that its first step is aborted:
-/// the run and the simulation it ran in.
+/// Plans scenario `name` (with `opts.plan`) with the paper's lift threshold and
+/// executes it with one no posture meets (30 cm, for the executor only), so that its
+/// first step is aborted: the run and the simulation it ran in.
 fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) {
     let planned = common::scenario(name);
     let mut sc = planned.clone();
@@ -442,7 +455,7 @@ fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) 
     let wall = Instant::now();
     let mut sim = Simulation::new(&sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
-    let plan = plan::run(&planned, &robot, &plan_options()).expect("plan");
+    let plan = plan::run(&planned, &robot, &opts.plan).expect("plan");
     let detailed =
         run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
     momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");

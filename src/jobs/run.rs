@@ -114,8 +114,9 @@ pub struct RunOptions {
 /// be, so a run's plan (the schedule's, or else the probe's) is the same everywhere as
 /// long as the time limit does not bind first (the dev build expands 15–100k states/s:
 /// give it 60 s or more). The paper's staircase, the dearest repository scenario, needs
-/// 0.6M at ε = 3. A search without the probe's path is not capped: it may still prove
-/// that there is none.
+/// 1.5M at ε = 3 (0.9M while a support pre-check refused most of its steps): its runs
+/// take the probe's path. A search without the probe's path is not capped: it may still
+/// prove that there is none.
 pub const RUN_SCHEDULE_EXPANSIONS: u64 = 1_000_000;
 
 impl RunOptions {
