@@ -68,7 +68,7 @@ use super::kinematics::PostureError;
 use super::kinematics::{
     Evaluation, Posture, contacts_in, evaluate, evaluate_legs, interpolate, rotation, solve_chains,
 };
-use super::roll::roll_for_lateral_com;
+use super::roll::{RollError, roll_for_lateral_com};
 use super::standing::{StandingRule, StepStance, base_z_in};
 use crate::cost::CostMaps;
 use crate::feasibility::{DrivingCheck, Infeasible};
@@ -217,6 +217,18 @@ impl MotionError {
     }
 }
 
+/// Why a step candidate's alignment could not be built: its stance's CoM has no solved
+/// legs, or the roll (eqs. 6–8) has no solution. Kept as it is and put into words only if
+/// the whole step fails: most candidates the planner asks about do, and most of their
+/// alignments are fine.
+#[derive(Debug, Clone, thiserror::Error)]
+enum AlignmentError {
+    #[error(transparent)]
+    Posture(#[from] PostureError),
+    #[error(transparent)]
+    Roll(#[from] RollError),
+}
+
 fn kind_name(k: PathKind) -> &'static str {
     match k {
         PathKind::Start => "start",
@@ -361,10 +373,9 @@ impl<'a> Expander<'a> {
             .map_err(|e| format!("no standing leg height reaches every foot: {e}"))
     }
 
-    fn com_of(&mut self, p: &Posture) -> Result<[f64; 3], String> {
+    fn com_of(&mut self, p: &Posture) -> Result<[f64; 3], PostureError> {
         solve_chains(self.robot, p, self.o.standing.reach_margin_m)
             .map(|legs| self.model.com_of_solved(&legs))
-            .map_err(|e| e.to_string())
     }
 
     /// Checks one posture: the leg IK with the reach margin, thighs and shins clear of the
@@ -552,7 +563,7 @@ impl<'a> Expander<'a> {
         post_foot: [f64; 3],
         height: f64,
         wheel_fraction: f64,
-    ) -> Result<WheelAlignment, String> {
+    ) -> Result<WheelAlignment, AlignmentError> {
         let o = *self.o;
         let i = leg.index();
         let j = leg.same_side_partner().index();
@@ -656,7 +667,7 @@ impl<'a> Expander<'a> {
         &mut self,
         wheel: &WheelAlignment,
         roll_fraction: f64,
-    ) -> Result<Alignment, String> {
+    ) -> Result<Alignment, AlignmentError> {
         let o = *self.o;
         let yaw = self.cur.base_rpy[2];
         let (s, c) = yaw.sin_cos();
@@ -674,8 +685,7 @@ impl<'a> Expander<'a> {
             if (lateral(com) - y_target).abs() < 0.003 {
                 break;
             }
-            let sol = roll_for_lateral_com([y_rot, z_rot], [lateral(com), com[2]], y_target, b)
-                .map_err(|e| e.to_string())?;
+            let sol = roll_for_lateral_com([y_rot, z_rot], [lateral(com), com[2]], y_target, b)?;
             // A roll that takes a stretched leg out of reach is halved (up to three
             // times) rather than dropping the candidate: part of the alignment still helps.
             let mut step = sol.roll;
@@ -840,7 +850,7 @@ impl<'a> Expander<'a> {
             rule.swing_z(self.robot, self.maps.heights(), pre[i], post_foot, self.cur.base_rpy[2]);
         // The best failure so far (the largest margin short of the requirement), put
         // into words only if the step fails: most candidates the planner asks about do.
-        let mut best: (f64, f64, Option<Result<SegmentFailure, String>>) =
+        let mut best: (f64, f64, Option<Result<SegmentFailure, AlignmentError>>) =
             (f64::NEG_INFINITY, self.o.min_margin_m, None);
         let candidates: Box<dyn Iterator<Item = (f64, f64, f64, Shift)>> = match search {
             StepSearch::Planner => {
@@ -853,13 +863,13 @@ impl<'a> Expander<'a> {
         // Candidates that differ only in their shift share their alignment, those that
         // differ only in their roll too its wheel move, and those whose sequences come out
         // the same (no shift where the wheel was not hindered) are checked once.
-        let mut wheels: Vec<((f64, f64), Result<WheelAlignment, String>)> = Vec::new();
-        let mut alignments: Vec<(AlignmentKey, Result<Alignment, String>)> = Vec::new();
+        let mut wheels: Vec<((f64, f64), Result<WheelAlignment, AlignmentError>)> = Vec::new();
+        let mut alignments: Vec<(AlignmentKey, Result<Alignment, AlignmentError>)> = Vec::new();
         let mut tried: Vec<Vec<Planned>> = Vec::new();
         // Early keyframes that failed (candidates can share them).
         let mut failed_early: Vec<Posture> = Vec::new();
         let min_margin = self.o.min_margin_m;
-        let note = |best: &mut (f64, f64, Option<Result<SegmentFailure, String>>),
+        let note = |best: &mut (f64, f64, Option<Result<SegmentFailure, AlignmentError>>),
                     f: SegmentFailure| {
             let (m, r) = match f.cause {
                 Infeasible::Margin { margin_m, required_m } => (margin_m, required_m),
@@ -935,7 +945,7 @@ impl<'a> Expander<'a> {
             required_m: best.1,
             reason: match best.2 {
                 Some(Ok(f)) => f.to_string(),
-                Some(Err(e)) => e,
+                Some(Err(e)) => e.to_string(),
                 None => "no candidate".to_owned(),
             },
         })
