@@ -41,8 +41,9 @@
 //! **Alternatives before failing**: a step is tried at the leg heights of the shared
 //! standing rule at which it stays within reach (`StandingRule::step_heights`, the same
 //! check the planner made), tallest first, then at 0.50 and 0.55 m; for each, full
-//! wheel-to-centre alignment, half, none, and as far as the wheel may go (what the
-//! planner's support check assumed); full, half, then no roll; a base shift taking what
+//! wheel-to-centre alignment, half, none, and as far as the wheel may go (a diagonal
+//! support edge may need it further in than alignment asks); full, half, then no roll; a
+//! base shift taking what
 //! the wheel leaves (all, half, none). Then, as a second pass, fixed base shifts of
 //! ±2.5 to ±20 cm with every wheel and roll choice. The first candidate whose every point
 //! holds is taken; otherwise [`MotionError::Step`] names the step, the leg and the best
@@ -589,9 +590,9 @@ impl<'a> Expander<'a> {
         } else {
             along(pre[j]) - (along(pre[i]).max(along(post_foot)) + o.wheel_gap_m)
         };
-        // `wheel_fraction` of the aligning move, or (infinite) as far as allowed: the
-        // planner's support check assumes that much (a diagonal support edge may need the
-        // wheel further in than longitudinal alignment asks).
+        // `wheel_fraction` of the aligning move, or (infinite) as far as allowed: a
+        // diagonal support edge may need the wheel further in than longitudinal
+        // alignment asks.
         let target = if wheel_fraction.is_infinite() {
             o.max_wheel_to_centre_m
         } else {
@@ -603,8 +604,7 @@ impl<'a> Expander<'a> {
         while d + step <= target + 1e-9 {
             let e = d + step;
             let (x, y) = (pre[j][0] + sign * e * c, pre[j][1] + sign * e * s);
-            // The wheel pair rolls along the base heading: its foot cost at that heading
-            // (the planner's support check asks the same, `locomotion::hybrid`).
+            // The wheel pair rolls along the base heading: its foot cost at that heading.
             let ok = self.maps.foot_cost_at_heading(x, y, yaw).is_finite()
                 && self.maps.height_at(x, y).is_some_and(|h| (h - pre[j][2]).abs() < 0.02);
             if !ok {

@@ -24,7 +24,7 @@ use super::kinematics::{
     BaseFrame, Posture, PostureError, SolvedLegs, apply, contacts_in, pitch_from_feet, rotation,
     solve_chains, solve_chains_in,
 };
-use crate::geometry::{Pose2, norm2};
+use crate::geometry::norm2;
 use crate::params::Params;
 use crate::robot::RobotDescription;
 use crate::robot::ik::{LegChain, knee_and_ankle, leg_fk};
@@ -351,25 +351,6 @@ impl StandingRule {
             }
             failed.is_none()
         })
-    }
-}
-
-impl StandingRule {
-    /// The posture at the start of a step of leg `leg` from feet `pre` to `post_foot`,
-    /// the base at `base`, at leg height `height`: all feet still down, the step's pitch,
-    /// the stepping leg counting the higher ground (as [`Self::step_heights`] checks it).
-    pub fn step_posture(
-        &self,
-        robot: &RobotDescription,
-        pre: [[f64; 3]; 4],
-        leg: usize,
-        post_foot: [f64; 3],
-        base: &Pose2,
-        height: f64,
-    ) -> Posture {
-        let StepStance { pitch, ground, .. } = self.step_stance(&pre, leg, post_foot, base.theta);
-        let xy = [base.x, base.y];
-        level_posture(robot, pre, [true; 4], xy, [0.0, pitch, base.theta], height, ground)
     }
 }
 

@@ -126,24 +126,19 @@ pub fn leg_chain(
     let c2 = ((d2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)).clamp(-1.0, 1.0);
     let knee_sign = if leg.is_front() { -1.0 } else { 1.0 };
     let q2 = knee_sign * c2.acos();
-    // The thigh leaves the hip–ankle line by γ towards the side the knee points to:
-    // cos γ = (l1² + d² − l2²)/(2·l1·d) by the law of cosines.
-    let (cos_g, sin_g) = if d > 0.0 {
-        let cos_g = ((l1 * l1 + d2 - l2 * l2) / (2.0 * l1 * d)).clamp(-1.0, 1.0);
-        (cos_g, knee_sign * (1.0 - cos_g * cos_g).sqrt())
-    } else {
-        // The ankle on the hip (equal segments folded flat): every knee on the circle of
-        // radius l1 solves it; the thigh along β.
-        (1.0, 0.0)
-    };
     let (q1, knee) = if d > 0.0 {
-        // The unit vector hip → ankle turned by γ; the thigh's angle from straight down
-        // is the hip angle (one arctangent where β − γ takes two).
+        // The thigh leaves the hip–ankle line by γ towards the side the knee points to:
+        // cos γ = (l1² + d² − l2²)/(2·l1·d) by the law of cosines. The knee is the unit
+        // vector hip → ankle turned by γ; the thigh's angle from straight down is the hip
+        // angle (one arctangent where β − γ takes two).
+        let cos_g = ((l1 * l1 + d2 - l2 * l2) / (2.0 * l1 * d)).clamp(-1.0, 1.0);
+        let sin_g = knee_sign * (1.0 - cos_g * cos_g).sqrt();
         let e = [ankle[0] / d, ankle[1] / d];
         let knee = [l1 * (cos_g * e[0] - sin_g * e[1]), l1 * (sin_g * e[0] + cos_g * e[1])];
         ((-knee[0]).atan2(-knee[1]), knee)
     } else {
-        // No direction to turn: the thigh along β, the hip–ankle direction's angle.
+        // The ankle on the hip (equal segments folded flat): every knee on the circle of
+        // radius l1 solves it; the thigh along β, the hip–ankle direction's angle.
         let q1 = (-ankle[0]).atan2(-ankle[1]);
         let a = u(q1);
         (q1, [l1 * a[0], l1 * a[1]])
