@@ -530,6 +530,8 @@ fn plan_json_prints_one_object_whatever_happens() {
     let (code, v) = plan_json(&[room.to_str().unwrap()]);
     assert_eq!((code, v["failure_kind"].as_str()), (Some(1), Some("no_path")), "{v}");
     assert!(v["failure"].as_str().is_some_and(|f| f.contains("closed_room.toml")), "{v}");
+    // ...and what the proof took.
+    assert!(v["failure"].as_str().is_some_and(|f| f.contains(" expansions, ")), "{v}");
     // The time limit before any path: exit 1, `planning_time_limit`.
     let stairs = common::root().join("scenarios/staircase.toml");
     let (code, v) = plan_json(&[stairs.to_str().unwrap(), "--time-limit", "0.001"]);

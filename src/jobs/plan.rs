@@ -823,9 +823,13 @@ fn search_prepared(
     }
     let Some(best) = result.best() else {
         let reason = match result.termination {
-            Termination::NoPath => {
-                "the goal cannot be reached: every reachable pose has been searched".to_owned()
-            }
+            Termination::NoPath => format!(
+                "the goal cannot be reached: every reachable pose has been searched \
+                 ({} expansions, {} states, {:.1} s)",
+                result.expansions,
+                result.states,
+                result.elapsed.as_secs_f64()
+            ),
             Termination::TimeLimit => format!(
                 "none found within the time limit of {} s ({} expansions)",
                 opts.time_limit_s, result.expansions
