@@ -28,7 +28,7 @@ use crate::cost::{Cost as CostValue, CostError, CostMaps};
 use crate::geometry::Pose2;
 use crate::locomotion::{
     Algorithm, DrivingGoal, HeuristicCache, HybridConfig, HybridGraph, Lattice, LatticeError,
-    LatticeState, ManoeuvreKind, Neighbourhood, PoseKey, StepCost,
+    LatticeState, ManoeuvreKind, ManoeuvreStats, Neighbourhood, PoseKey, StepCost,
 };
 use crate::params::{FootModel, InvalidParam, Params};
 use crate::planner::{
@@ -825,14 +825,17 @@ fn search_prepared(
         let reason = match result.termination {
             Termination::NoPath => format!(
                 "the goal cannot be reached: every reachable pose has been searched \
-                 ({} expansions, {} states, {:.1} s)",
+                 ({} expansions, {} states, {:.1} s{})",
                 result.expansions,
                 result.states,
-                result.elapsed.as_secs_f64()
+                result.elapsed.as_secs_f64(),
+                step_checks_said(&graph.stats())
             ),
             Termination::TimeLimit => format!(
-                "none found within the time limit of {} s ({} expansions)",
-                opts.time_limit_s, result.expansions
+                "none found within the time limit of {} s ({} expansions{})",
+                opts.time_limit_s,
+                result.expansions,
+                step_checks_said(&graph.stats())
             ),
             t => format!("the search stopped ({})", termination_name(t)),
         };
@@ -1198,9 +1201,47 @@ fn row(
     }
 }
 
+/// How a search's step checks ended, for a failure's message: `; of N step checks M
+/// failed: …` (empty when no step was checked). Where the steps fail says what stopped
+/// the search: no leg height within reach, or front or rear steps with no stable motion.
+fn step_checks_said(stats: &ManoeuvreStats) -> String {
+    let failed = stats.steps_failed();
+    let checked = failed + stats.step_checks_passed;
+    if checked == 0 {
+        return String::new();
+    }
+    format!(
+        "; of {checked} step checks {failed} failed: {} with no leg height within reach, \
+         {} front and {} rear steps with no stable motion, {} otherwise",
+        stats.steps_without_leg_height,
+        stats.front_steps_unstable,
+        stats.rear_steps_unstable,
+        stats.steps_failed_otherwise
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::BenchRow;
+
+    #[test]
+    fn a_failure_says_how_its_step_checks_ended() {
+        use crate::locomotion::ManoeuvreStats;
+        assert_eq!(super::step_checks_said(&ManoeuvreStats::default()), "");
+        let stats = ManoeuvreStats {
+            step_checks_passed: 10,
+            steps_without_leg_height: 4,
+            front_steps_unstable: 3,
+            rear_steps_unstable: 2,
+            steps_failed_otherwise: 1,
+            ..ManoeuvreStats::default()
+        };
+        assert_eq!(
+            super::step_checks_said(&stats),
+            "; of 20 step checks 10 failed: 4 with no leg height within reach, 3 front and \
+             2 rear steps with no stable motion, 1 otherwise"
+        );
+    }
 
     fn run(first: f64, to_optimum: Option<f64>, at_1s: Option<f64>, rate: f64) -> BenchRow {
         BenchRow {

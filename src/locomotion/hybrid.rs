@@ -397,6 +397,40 @@ pub struct ManoeuvreStats {
     pub foot_neutral: u64,
     /// Manoeuvres dropped because the footprint table was full.
     pub footprint_table_full: u64,
+    /// Step checks the motion generator passed (the checks run: each step of a state is
+    /// checked once, `step_checks` memoises it).
+    pub step_checks_passed: u64,
+    /// Step checks that found no leg height within reach (the standing rule's
+    /// `step_heights`): the generator was not asked.
+    pub steps_without_leg_height: u64,
+    /// Step checks of a front leg the generator turned down: no candidate motion kept
+    /// the robot stable and within reach.
+    pub front_steps_unstable: u64,
+    /// The same for a rear leg.
+    pub rear_steps_unstable: u64,
+    /// Step checks that failed otherwise (no standing posture before the step, unknown
+    /// terrain).
+    pub steps_failed_otherwise: u64,
+}
+
+impl ManoeuvreStats {
+    /// Step checks that failed, for any reason.
+    pub fn steps_failed(&self) -> u64 {
+        self.steps_without_leg_height
+            + self.front_steps_unstable
+            + self.rear_steps_unstable
+            + self.steps_failed_otherwise
+    }
+}
+
+/// How the step checks of a graph ended (see [`ManoeuvreStats`]).
+#[derive(Debug, Clone, Copy, Default)]
+struct StepChecks {
+    passed: u64,
+    no_leg_height: u64,
+    /// Front legs, rear legs.
+    unstable: [u64; 2],
+    otherwise: u64,
 }
 
 /// What the hybrid graph's heuristic looks up, built once per graph (at its first use).
@@ -470,6 +504,9 @@ pub struct HybridGraph<'c> {
     /// Scratch buffer for the labelled special successors.
     special: Vec<(LatticeState, Cost, Manoeuvre)>,
     stats: ManoeuvreStats,
+    /// How the step checks ended (counted in `step_feasible`, which takes `&self`); read
+    /// into [`ManoeuvreStats`] by [`HybridGraph::stats`].
+    check_outcomes: Cell<StepChecks>,
     /// The heuristic's tables, built (or taken from `heuristic_cache`) at its first
     /// use, and whether they were taken: a graph asked only for edges (`jobs::plan`'s
     /// plain-cost graph) never builds them.
@@ -650,6 +687,7 @@ impl<'c> HybridGraph<'c> {
             foot_move_cells,
             special: Vec::with_capacity(16),
             stats: ManoeuvreStats::default(),
+            check_outcomes: Cell::new(StepChecks::default()),
             heuristic: OnceCell::new(),
             heuristic_cache: None,
             heuristic_deadline: Cell::new(None),
@@ -868,9 +906,24 @@ impl<'c> HybridGraph<'c> {
         self.reach
     }
 
-    /// Manoeuvres generated so far.
+    /// Manoeuvres generated so far, and how their step checks ended.
     pub fn stats(&self) -> ManoeuvreStats {
-        self.stats
+        let c = self.check_outcomes.get();
+        ManoeuvreStats {
+            step_checks_passed: c.passed,
+            steps_without_leg_height: c.no_leg_height,
+            front_steps_unstable: c.unstable[0],
+            rear_steps_unstable: c.unstable[1],
+            steps_failed_otherwise: c.otherwise,
+            ..self.stats
+        }
+    }
+
+    /// Counts one step check's outcome.
+    fn count_step_check(&self, add: impl FnOnce(&mut StepChecks)) {
+        let mut c = self.check_outcomes.get();
+        add(&mut c);
+        self.check_outcomes.set(c);
     }
 
     /// Number of footprints met so far (the neutral one included).
@@ -1062,9 +1115,19 @@ impl<'c> HybridGraph<'c> {
             )
             .peekable();
         if heights.peek().is_none() {
+            self.count_step_check(|c| c.no_leg_height += 1);
             return false;
         }
-        self.generator_check(s, feet, |check, pre| check.step(pre, Leg::ALL[leg], post, heights))
+        let outcome = self
+            .generator_outcome(s, feet, |check, pre| check.step(pre, Leg::ALL[leg], post, heights));
+        self.count_step_check(|c| match outcome {
+            Ok(()) => c.passed += 1,
+            Err(Some(MotionError::Step { .. })) => {
+                c.unstable[usize::from(!Leg::ALL[leg].is_front())] += 1;
+            }
+            Err(_) => c.otherwise += 1,
+        });
+        outcome.is_ok()
     }
 
     /// Runs one of the generator's own checks (`check`, [`ManoeuvreCheck`]) from
@@ -1076,18 +1139,29 @@ impl<'c> HybridGraph<'c> {
         feet: &Feet,
         check: impl FnOnce(&mut ManoeuvreCheck<'_>, Posture) -> Result<(), MotionError>,
     ) -> bool {
+        self.generator_outcome(s, feet, check).is_ok()
+    }
+
+    /// [`Self::generator_check`]'s outcome: the check's error, or `None` where the rule
+    /// found no standing posture to start from.
+    fn generator_outcome(
+        &self,
+        s: LatticeState,
+        feet: &Feet,
+        check: impl FnOnce(&mut ManoeuvreCheck<'_>, Posture) -> Result<(), MotionError>,
+    ) -> Result<(), Option<MotionError>> {
         let pose = self.lattice.pose(s);
         let robot = &self.robot;
         let rule = &self.config.motion.standing;
         let world = Self::feet_xyz(feet);
         let xy = [pose.x, pose.y];
         let Ok((pre, _)) = rule.stand(robot, self.maps.leg_terrain(), world, xy, pose.theta) else {
-            return false;
+            return Err(None);
         };
         let mut model = EstimatedCom { robot };
         let options = &self.config.motion;
         let mut c = ManoeuvreCheck { robot, maps: self.maps, model: &mut model, options };
-        check(&mut c, pre).is_ok()
+        check(&mut c, pre).map_err(Some)
     }
 
     /// Whether state `t` (footprint offsets `o`) may be entered; its body cost for

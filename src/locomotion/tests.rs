@@ -1007,6 +1007,9 @@ mod hybrid {
         let before = g.stats().steps;
         check_consistent(&mut g, s);
         assert!(g.stats().steps > before, "expanding a node checks its step");
+        // ...and counts how its checks ended: the step onto the platform holds.
+        let st = g.stats();
+        assert!(st.step_checks_passed > 0, "{st:?}");
         let start = state_at(&g, 0.0, 0.0);
         let r = astar(&mut g, start, &SearchParams::default());
         let best = r.best().expect("a path onto the platform");
