@@ -822,6 +822,7 @@ fn search_prepared(
             .map_err(|source| PlanJobError::Image { source })?;
     }
     let Some(best) = result.best() else {
+        let checks = step_checks_said(&graph.stats());
         let reason = match result.termination {
             Termination::NoPath => format!(
                 "the goal cannot be reached: every reachable pose has been searched \
@@ -829,13 +830,11 @@ fn search_prepared(
                 result.expansions,
                 result.states,
                 result.elapsed.as_secs_f64(),
-                step_checks_said(&graph.stats())
+                checks
             ),
             Termination::TimeLimit => format!(
                 "none found within the time limit of {} s ({} expansions{})",
-                opts.time_limit_s,
-                result.expansions,
-                step_checks_said(&graph.stats())
+                opts.time_limit_s, result.expansions, checks
             ),
             t => format!("the search stopped ({})", termination_name(t)),
         };

@@ -423,16 +423,6 @@ impl ManoeuvreStats {
     }
 }
 
-/// How the step checks of a graph ended (see [`ManoeuvreStats`]).
-#[derive(Debug, Clone, Copy, Default)]
-struct StepChecks {
-    passed: u64,
-    no_leg_height: u64,
-    /// Front legs, rear legs.
-    unstable: [u64; 2],
-    otherwise: u64,
-}
-
 /// What the hybrid graph's heuristic looks up, built once per graph (at its first use).
 struct HeuristicTables {
     /// Base cells that can still reach the goal (`reachability`): an infinite heuristic
@@ -503,10 +493,9 @@ pub struct HybridGraph<'c> {
     foot_move_cells: i8,
     /// Scratch buffer for the labelled special successors.
     special: Vec<(LatticeState, Cost, Manoeuvre)>,
-    stats: ManoeuvreStats,
-    /// How the step checks ended (counted in `step_feasible`, which takes `&self`); read
-    /// into [`ManoeuvreStats`] by [`HybridGraph::stats`].
-    check_outcomes: Cell<StepChecks>,
+    /// The counters; a `Cell`, as the step checks are counted in `step_feasible`, which
+    /// takes `&self`.
+    stats: Cell<ManoeuvreStats>,
     /// The heuristic's tables, built (or taken from `heuristic_cache`) at its first
     /// use, and whether they were taken: a graph asked only for edges (`jobs::plan`'s
     /// plain-cost graph) never builds them.
@@ -686,8 +675,7 @@ impl<'c> HybridGraph<'c> {
             trig,
             foot_move_cells,
             special: Vec::with_capacity(16),
-            stats: ManoeuvreStats::default(),
-            check_outcomes: Cell::new(StepChecks::default()),
+            stats: Cell::new(ManoeuvreStats::default()),
             heuristic: OnceCell::new(),
             heuristic_cache: None,
             heuristic_deadline: Cell::new(None),
@@ -908,22 +896,14 @@ impl<'c> HybridGraph<'c> {
 
     /// Manoeuvres generated so far, and how their step checks ended.
     pub fn stats(&self) -> ManoeuvreStats {
-        let c = self.check_outcomes.get();
-        ManoeuvreStats {
-            step_checks_passed: c.passed,
-            steps_without_leg_height: c.no_leg_height,
-            front_steps_unstable: c.unstable[0],
-            rear_steps_unstable: c.unstable[1],
-            steps_failed_otherwise: c.otherwise,
-            ..self.stats
-        }
+        self.stats.get()
     }
 
-    /// Counts one step check's outcome.
-    fn count_step_check(&self, add: impl FnOnce(&mut StepChecks)) {
-        let mut c = self.check_outcomes.get();
-        add(&mut c);
-        self.check_outcomes.set(c);
+    /// Adds one to the counter `counter` picks.
+    fn count(&self, counter: impl FnOnce(&mut ManoeuvreStats) -> &mut u64) {
+        let mut stats = self.stats.get();
+        *counter(&mut stats) += 1;
+        self.stats.set(stats);
     }
 
     /// Number of footprints met so far (the neutral one included).
@@ -1115,17 +1095,18 @@ impl<'c> HybridGraph<'c> {
             )
             .peekable();
         if heights.peek().is_none() {
-            self.count_step_check(|c| c.no_leg_height += 1);
+            self.count(|c| &mut c.steps_without_leg_height);
             return false;
         }
         let outcome = self
             .generator_outcome(s, feet, |check, pre| check.step(pre, Leg::ALL[leg], post, heights));
-        self.count_step_check(|c| match outcome {
-            Ok(()) => c.passed += 1,
-            Err(Some(MotionError::Step { .. })) => {
-                c.unstable[usize::from(!Leg::ALL[leg].is_front())] += 1;
+        self.count(|c| match outcome {
+            Ok(()) => &mut c.step_checks_passed,
+            Err(Some(MotionError::Step { .. })) if Leg::ALL[leg].is_front() => {
+                &mut c.front_steps_unstable
             }
-            Err(_) => c.otherwise += 1,
+            Err(Some(MotionError::Step { .. })) => &mut c.rear_steps_unstable,
+            Err(_) => &mut c.steps_failed_otherwise,
         });
         outcome.is_ok()
     }
@@ -1309,7 +1290,7 @@ impl<'c> HybridGraph<'c> {
         match self.footprints.intern(o) {
             Some(footprint) => Some(LatticeState { footprint, ..t }),
             None => {
-                self.stats.footprint_table_full += 1;
+                self.count(|c| &mut c.footprint_table_full);
                 None
             }
         }
@@ -1683,8 +1664,8 @@ impl<'c> HybridGraph<'c> {
             return;
         };
         match m.kind {
-            ManoeuvreKind::FootForward => self.stats.foot_forward += 1,
-            _ => self.stats.foot_neutral += 1,
+            ManoeuvreKind::FootForward => self.count(|c| &mut c.foot_forward),
+            _ => self.count(|c| &mut c.foot_neutral),
         }
         self.special.push((t, edge_cost(m.cost), m.manoeuvre()));
     }
@@ -1716,7 +1697,7 @@ impl<'c> HybridGraph<'c> {
     ) -> Option<(LatticeState, Cost, Manoeuvre)> {
         let (o2, step) = self.best_step(s, o, feet, k, candidates)?;
         let t = self.with_footprint(s, o2)?;
-        self.stats.steps += 1;
+        self.count(|c| &mut c.steps);
         let (cost, m) = self.step_edge(k, step);
         Some((t, cost, m))
     }
@@ -1952,7 +1933,7 @@ impl<'c> HybridGraph<'c> {
         }
         let cost = (self.config.step_cost_factor * base_shift_cost(&self.config, length, cb_avg))
             .max(moved);
-        self.stats.base_shifts += 1;
+        self.count(|c| &mut c.base_shifts);
         self.special.push((
             t,
             edge_cost(cost),
