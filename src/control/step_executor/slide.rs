@@ -37,7 +37,10 @@
 //! (measured: steering regardless, 4 of 30 generated flights aborted a step, 13 cm of
 //! margin gone to 3 cm). So each roll is checked on the height map first
 //! ([`StepExecutor::steering_keeps_the_ground`]: every steered pair must rest as the
-//! straight one does, where it starts and where it ends). Where the whole way back fails,
+//! straight one does, where it starts and where it ends), from where each pair was
+//! measured: the rigid fit leaves every foot its own residual, 2–4 cm late in a descent
+//! of a flight at 45° to the map, where a roll checked at the fitted feet steered a rear
+//! pair against the riser its wheels stood 1.5 cm clear of. Where the whole way back fails,
 //! the turn goes first on its own: on the spot (each pair 40–50° from the heading), or
 //! where that fails in two arcs of half the turn about centres to either side (0.6–2 m
 //! away, steering 45–11°; one arc forward and one backward, like a three-point turn);
@@ -95,6 +98,9 @@ pub struct StanceError {
     pub yaw: f64,
     /// The largest distance of a measured foot from its foothold, m.
     pub worst_m: f64,
+    /// Where each measured leg stands (world x, y, m; `Leg` order), `None` for a leg not
+    /// measured: the rigid fit leaves each foot its own residual.
+    pub feet: [Option<[f64; 2]>; 4],
 }
 
 impl StanceError {
@@ -123,6 +129,7 @@ pub fn stance_error(
 ) -> Option<StanceError> {
     let track = robot.wheel_track;
     let mut pairs: Vec<([f64; 2], [f64; 2])> = Vec::with_capacity(4);
+    let mut feet = [None; 4];
     for leg in Leg::ALL.into_iter().filter(|l| planned.contact[l.index()]) {
         let pts: Vec<[f64; 2]> =
             contacts.iter().filter(|(l, _)| *l == leg).map(|(_, p)| *p).collect();
@@ -140,7 +147,9 @@ pub fn stance_error(
             continue;
         }
         let f = planned.feet[leg.index()];
-        pairs.push(([f[0], f[1]], [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]));
+        let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+        feet[leg.index()] = Some(m);
+        pairs.push(([f[0], f[1]], m));
     }
     if pairs.len() < 2 {
         return None;
@@ -169,6 +178,7 @@ pub fn stance_error(
         offset: [measured[0] - centre[0], measured[1] - centre[1]],
         yaw,
         worst_m,
+        feet,
     })
 }
 
@@ -301,8 +311,15 @@ impl StepExecutor {
             return None;
         }
         let p = self.with_offsets(&self.cmd);
-        // The feet stand where the error puts the planned footholds.
-        let now = rolled(&p, &err.forward());
+        // The feet stand where the error puts the planned footholds, each measured one
+        // where it was measured.
+        let mut now = rolled(&p, &err.forward());
+        for (f, m) in now.feet.iter_mut().zip(err.feet) {
+            if let Some(m) = m {
+                f[0] = m[0];
+                f[1] = m[1];
+            }
+        }
         let back = err.back();
         if self.rolls_keep_the_ground(&now, &[back]) {
             return Some(vec![back]);
@@ -559,7 +576,13 @@ mod tests {
     /// The stance error of a stance shifted by `offset` and not turned (the standing
     /// feet's centroid is the origin).
     fn shifted(offset: [f64; 2]) -> StanceError {
-        StanceError { centre: [0.0; 2], offset, yaw: 0.0, worst_m: offset[0].hypot(offset[1]) }
+        StanceError {
+            centre: [0.0; 2],
+            offset,
+            yaw: 0.0,
+            worst_m: offset[0].hypot(offset[1]),
+            feet: [None; 4],
+        }
     }
 
     #[test]
@@ -572,6 +595,9 @@ mod tests {
         assert!(near(e.offset[0], 0.01) && near(e.offset[1], -0.03) && near(e.yaw, 0.0), "{e:?}");
         assert!(near(e.centre[0], 0.0) && near(e.centre[1], 0.0));
         assert!((e.worst_m - 0.031623).abs() < 1e-6, "{e:?}");
+        // Each leg where its two wheels' midpoint is.
+        let fr = p.feet[Leg::FrontRight.index()];
+        assert_eq!(e.feet[Leg::FrontRight.index()], Some([fr[0] + 0.01, fr[1] - 0.03]));
         // Turned by 0.02 rad about the centroid (the origin) and shifted 1 cm along y:
         // the feet at 0.4749 m from it move 0.4749 · 0.02 = 9.5 mm around it.
         let turn = Roll { centre: [0.0; 2], turn: 0.02, shift: [0.0, 0.01] };
@@ -724,6 +750,43 @@ mod tests {
         let ex = StepExecutor::new(&robot(), config(), step_path(), riser_from(0.475));
         let r = shifts(&ex, [0.0, -0.03]).unwrap();
         assert!(r.len() == 2 && close(r[0], [-0.015, 0.015]) && close(r[1], [0.015, 0.015]));
+    }
+
+    #[test]
+    fn a_roll_is_checked_where_each_pair_was_measured_not_where_the_fit_puts_it() {
+        // The stance measured 3 cm to the left (+y), the front pairs 5 cm ahead of their
+        // footholds as well (x = 0.40 m, the rear ones at −0.35 m): the rigid fit moves
+        // every foothold by (0.025, 0.03) and turns none, which puts the front feet at
+        // x = 0.375 m, 2.5 cm behind where their wheels touch. All of it back in one roll
+        // steers every pair to roll along (−0.025, −0.03), its axle along (0.768, −0.640):
+        // a front wheel 0.06 · 0.768 = 0.0461 m ahead of its foot. With a riser from
+        // x = 0.5136 m, a sphere of 8 cm there reaches 0.375 + 0.0461 + 0.08 = 0.5011 m
+        // from the fitted foot (clear by 1.25 cm) but 0.5261 m from the measured one
+        // (1.25 cm into the riser), which steered straight reaches 0.48 m. On a diagonal
+        // stair descent the fit's residuals grew to 2-4 cm, and a roll checked at the fit
+        // steered a rear pair against the riser: the chassis rocked, the CoM 1.7 cm
+        // outside the wheels that touched.
+        // Columns from i = 100: x ≥ −1.9864 + 100 · 0.025 = 0.5136 m.
+        let height = |i: usize, _: usize| if i >= 100 { 0.17 } else { 0.0 };
+        let riser = HeightMap::from_fn([-1.9864, -2.0], 0.025, 160, 160, height).unwrap();
+        let ex = StepExecutor::new(&robot(), config(), step_path(), riser);
+        let p = standing();
+        let contacts: Vec<(Leg, [f64; 2])> = two_wheel_contacts(&p, [0.0, 0.03])
+            .into_iter()
+            .map(|(l, c)| (l, if l.is_front() { [c[0] + 0.05, c[1]] } else { c }))
+            .collect();
+        let err = stance_error(&robot(), &p, &contacts).unwrap();
+        let near = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(near(err.offset[0], 0.025) && near(err.offset[1], 0.03) && near(err.yaw, 0.0));
+        let fl = err.feet[Leg::FrontLeft.index()].unwrap();
+        assert!(near(fl[0], 0.40) && near(fl[1], 0.35), "{fl:?}");
+        // Checked at the fit, the one roll back would keep the ground; where the pairs
+        // stand, it does not, and the slide takes another way.
+        let fitted = rolled(&p, &err.forward());
+        assert!(ex.rolls_keep_the_ground(&fitted, &[err.back()]));
+        let rolls = ex.slide_rolls(&err).unwrap();
+        assert_ne!(rolls, vec![err.back()]);
+        assert!(rolls.len() == 2 && rolls.iter().all(|r| r.turn == 0.0), "{rolls:?}");
     }
 
     /// The stance of [`standing`] turned by `yaw` (rad) about its centre (the origin),
