@@ -37,10 +37,13 @@
 //! (measured: steering regardless, 4 of 30 generated flights aborted a step, 13 cm of
 //! margin gone to 3 cm). So each roll is checked on the height map first
 //! ([`StepExecutor::steering_keeps_the_ground`]: every steered pair must rest as the
-//! straight one does, where it starts and where it ends), from where each pair was
-//! measured: the rigid fit leaves every foot its own residual, 2–4 cm late in a descent
-//! of a flight at 45° to the map, where a roll checked at the fitted feet steered a rear
-//! pair against the riser its wheels stood 1.5 cm clear of. Where the whole way back fails,
+//! straight one does, where it starts and where it ends), both from where the rigid fit
+//! puts the feet and from where each pair was measured: the fit leaves every foot its own
+//! residual, 2–4 cm late in a descent of a flight at 45° to the map, where a roll checked
+//! at the fitted feet alone steered a rear pair against the riser its wheels stood 1.5 cm
+//! clear of; checked at the measured feet alone, rolls the fit refuses went ahead (a
+//! contact midpoint is not always the foot), and a generated flight that climbed was
+//! stranded. Where the whole way back fails,
 //! the turn goes first on its own: on the spot (each pair 40–50° from the heading), or
 //! where that fails in two arcs of half the turn about centres to either side (0.6–2 m
 //! away, steering 45–11°; one arc forward and one backward, like a three-point turn);
@@ -288,14 +291,17 @@ impl StepExecutor {
         })
     }
 
-    /// Whether the rolls, one after the other from the stance `from`, each keep the
-    /// ground ([`Self::steering_keeps_the_ground`]).
-    fn rolls_keep_the_ground(&self, from: &Posture, rolls: &[Roll]) -> bool {
-        let mut at = *from;
-        rolls.iter().all(|r| {
-            let ok = self.steering_keeps_the_ground(&at, r);
-            at = rolled(&at, r);
-            ok
+    /// Whether the rolls, one after the other from each of the stances `from` (the same
+    /// robot with its feet by each estimate), each keep the ground
+    /// ([`Self::steering_keeps_the_ground`]).
+    fn rolls_keep_the_ground(&self, from: &[Posture], rolls: &[Roll]) -> bool {
+        from.iter().all(|p| {
+            let mut at = *p;
+            rolls.iter().all(|r| {
+                let ok = self.steering_keeps_the_ground(&at, r);
+                at = rolled(&at, r);
+                ok
+            })
         })
     }
 
@@ -311,27 +317,30 @@ impl StepExecutor {
             return None;
         }
         let p = self.with_offsets(&self.cmd);
-        // The feet stand where the error puts the planned footholds, each measured one
-        // where it was measured.
-        let mut now = rolled(&p, &err.forward());
-        for (f, m) in now.feet.iter_mut().zip(err.feet) {
+        // The feet stand where the error puts the planned footholds (the rigid fit), or
+        // each measured one where it was measured: a roll is made only if it keeps the
+        // ground from both.
+        let fitted = rolled(&p, &err.forward());
+        let mut measured = fitted;
+        for (f, m) in measured.feet.iter_mut().zip(err.feet) {
             if let Some(m) = m {
                 f[0] = m[0];
                 f[1] = m[1];
             }
         }
+        let now = [fitted, measured];
         let back = err.back();
         if self.rolls_keep_the_ground(&now, &[back]) {
             return Some(vec![back]);
         }
         let reach = (0..4)
-            .map(|i| (now.feet[i][0] - back.centre[0]).hypot(now.feet[i][1] - back.centre[1]))
+            .map(|i| (fitted.feet[i][0] - back.centre[0]).hypot(fitted.feet[i][1] - back.centre[1]))
             .fold(0.0, f64::max);
         let mut rolls = Vec::with_capacity(4);
         if err.yaw.abs() * reach > SLIDE_DONE_M {
             rolls = self.turn_rolls(&now, back.centre, -err.yaw);
         }
-        let from = rolls.iter().fold(now, |q, r| rolled(&q, r));
+        let from = now.map(|p| rolls.iter().fold(p, |q, r| rolled(&q, r)));
         // The turns keep the stance's centre where it was, up to the arcs' second order.
         let centre = rolls.iter().fold(back.centre, |c, r| r.apply(c));
         let target = [err.centre[0] - centre[0], err.centre[1] - centre[1]];
@@ -347,7 +356,7 @@ impl StepExecutor {
     /// steering keeps the ground: at radius R a pair steers about atan(0.35 / (R − 0.32))
     /// from the heading and the stance rolls turn · R / 2 along it and back. None where
     /// nothing keeps the ground.
-    fn turn_rolls(&self, from: &Posture, centre: [f64; 2], turn: f64) -> Vec<Roll> {
+    fn turn_rolls(&self, from: &[Posture], centre: [f64; 2], turn: f64) -> Vec<Roll> {
         let on_the_spot = Roll { centre, turn, shift: [0.0; 2] };
         if self.rolls_keep_the_ground(from, &[on_the_spot]) {
             return vec![on_the_spot];
@@ -355,7 +364,8 @@ impl StepExecutor {
         let half = 0.5 * turn;
         // The unit vectors to the robot's left before the turn and half way through it.
         let left = |yaw: f64| [-yaw.sin(), yaw.cos()];
-        let (n, n1) = (left(from.base_rpy[2]), left(from.base_rpy[2] + half));
+        let yaw = from.first().map_or(0.0, |p| p.base_rpy[2]);
+        let (n, n1) = (left(yaw), left(yaw + half));
         for radius in TURN_ARC_RADII {
             for side in [1.0, -1.0] {
                 // The first arc's centre `radius` to the left (side 1) or right of the
@@ -386,7 +396,7 @@ impl StepExecutor {
     /// backward, their parts along the heading adding up to the shift's, in the order
     /// that keeps the ground); else its part along the heading (rolled straight, over
     /// footholds the plan checked) if that is more than the threshold; else none.
-    fn shift_rolls(&self, from: &Posture, back: [f64; 2]) -> Vec<Roll> {
+    fn shift_rolls(&self, from: &[Posture], back: [f64; 2]) -> Vec<Roll> {
         let threshold = self.config.slide_threshold_m;
         if back[0].hypot(back[1]) <= threshold {
             return Vec::new();
@@ -395,7 +405,7 @@ impl StepExecutor {
         if self.rolls_keep_the_ground(from, &[whole]) {
             return vec![whole];
         }
-        let (sy, cy) = from.base_rpy[2].sin_cos();
+        let (sy, cy) = from.first().map_or(0.0, |p| p.base_rpy[2]).sin_cos();
         let world = |a: f64, l: f64| Roll::straight([a * cy - l * sy, a * sy + l * cy]);
         let along = back[0] * cy + back[1] * sy;
         let lateral = -back[0] * sy + back[1] * cy;
@@ -780,10 +790,10 @@ mod tests {
         assert!(near(err.offset[0], 0.025) && near(err.offset[1], 0.03) && near(err.yaw, 0.0));
         let fl = err.feet[Leg::FrontLeft.index()].unwrap();
         assert!(near(fl[0], 0.40) && near(fl[1], 0.35), "{fl:?}");
-        // Checked at the fit, the one roll back would keep the ground; where the pairs
-        // stand, it does not, and the slide takes another way.
+        // Checked at the fit alone, the one roll back would keep the ground; where the
+        // pairs stand, it does not, and the slide takes another way.
         let fitted = rolled(&p, &err.forward());
-        assert!(ex.rolls_keep_the_ground(&fitted, &[err.back()]));
+        assert!(ex.rolls_keep_the_ground(&[fitted], &[err.back()]));
         let rolls = ex.slide_rolls(&err).unwrap();
         assert_ne!(rolls, vec![err.back()]);
         assert!(rolls.len() == 2 && rolls.iter().all(|r| r.turn == 0.0), "{rolls:?}");
@@ -833,7 +843,7 @@ mod tests {
         let err = stance_error(&robot(), &standing(), &turned_contacts(0.06)).unwrap();
         let now = rolled(&standing(), &err.forward());
         let on_the_spot = Roll { shift: [0.0; 2], ..err.back() };
-        assert!(!ex.rolls_keep_the_ground(&now, &[on_the_spot]));
+        assert!(!ex.rolls_keep_the_ground(&[now], &[on_the_spot]));
         let rolls = ex.slide_rolls(&err).unwrap();
         assert_eq!(rolls.len(), 2, "{rolls:?}");
         // Each arc half the turn, about centres on either side of the stance, at least
