@@ -348,15 +348,14 @@ impl StepExecutor {
         (!rolls.is_empty()).then_some(rolls)
     }
 
-    /// The rolls that turn the stance `from` by `turn` (rad) about `centre`: the turn on
-    /// the spot if the pairs can steer to it (each pair across its radius, 40–50° from
-    /// the heading); else two arcs of half the turn each, about centres
-    /// [`TURN_ARC_RADII`] to either side (the first arc forward and the second backward,
-    /// or the other way, like a three-point turn), with the smallest radius whose
-    /// steering keeps the ground: at radius R a pair steers about atan(0.35 / (R − 0.32))
-    /// from the heading and the stance rolls turn · R / 2 along it and back. None where
-    /// nothing keeps the ground.
-    fn turn_rolls(&self, from: &[Posture], centre: [f64; 2], turn: f64) -> Vec<Roll> {
+    /// The rolls that turn the stance `from` (fitted and measured feet, one base) by `turn` (rad)
+    /// about `centre`: the turn on the spot if the pairs can steer to it (each pair across its
+    /// radius, 40–50° from the heading); else two arcs of half the turn each, about centres
+    /// [`TURN_ARC_RADII`] to either side (the first arc forward and the second backward, or the
+    /// other way, like a three-point turn), with the smallest radius whose steering keeps the
+    /// ground: at radius R a pair steers about atan(0.35 / (R − 0.32)) from the heading and the
+    /// stance rolls turn · R / 2 along it and back. None where nothing keeps the ground.
+    fn turn_rolls(&self, from: &[Posture; 2], centre: [f64; 2], turn: f64) -> Vec<Roll> {
         let on_the_spot = Roll { centre, turn, shift: [0.0; 2] };
         if self.rolls_keep_the_ground(from, &[on_the_spot]) {
             return vec![on_the_spot];
@@ -364,7 +363,7 @@ impl StepExecutor {
         let half = 0.5 * turn;
         // The unit vectors to the robot's left before the turn and half way through it.
         let left = |yaw: f64| [-yaw.sin(), yaw.cos()];
-        let yaw = from.first().map_or(0.0, |p| p.base_rpy[2]);
+        let yaw = from[0].base_rpy[2];
         let (n, n1) = (left(yaw), left(yaw + half));
         for radius in TURN_ARC_RADII {
             for side in [1.0, -1.0] {
@@ -390,13 +389,13 @@ impl StepExecutor {
         Vec::new()
     }
 
-    /// The rolls that shift the stance `from` by `back` (world, m): all of it in one roll
-    /// if the pairs can steer to it; else its sideways part in two rolls at the largest of
-    /// [`ZIGZAG_ANGLES`] from the heading that the pairs can steer to (one forward, one
-    /// backward, their parts along the heading adding up to the shift's, in the order
-    /// that keeps the ground); else its part along the heading (rolled straight, over
+    /// The rolls that shift the stance `from` (fitted and measured feet, one base) by `back`
+    /// (world, m): all of it in one roll if the pairs can steer to it; else its sideways part in
+    /// two rolls at the largest of [`ZIGZAG_ANGLES`] from the heading that the pairs can steer to
+    /// (one forward, one backward, their parts along the heading adding up to the shift's, in the
+    /// order that keeps the ground); else its part along the heading (rolled straight, over
     /// footholds the plan checked) if that is more than the threshold; else none.
-    fn shift_rolls(&self, from: &[Posture], back: [f64; 2]) -> Vec<Roll> {
+    fn shift_rolls(&self, from: &[Posture; 2], back: [f64; 2]) -> Vec<Roll> {
         let threshold = self.config.slide_threshold_m;
         if back[0].hypot(back[1]) <= threshold {
             return Vec::new();
@@ -405,7 +404,7 @@ impl StepExecutor {
         if self.rolls_keep_the_ground(from, &[whole]) {
             return vec![whole];
         }
-        let (sy, cy) = from.first().map_or(0.0, |p| p.base_rpy[2]).sin_cos();
+        let (sy, cy) = from[0].base_rpy[2].sin_cos();
         let world = |a: f64, l: f64| Roll::straight([a * cy - l * sy, a * sy + l * cy]);
         let along = back[0] * cy + back[1] * sy;
         let lateral = -back[0] * sy + back[1] * cy;
