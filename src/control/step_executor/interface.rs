@@ -322,14 +322,14 @@ pub enum ExecStatus {
 #[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Stranding {
-    /// A foot would roll over an edge on its way back to the neutral footprint.
+    /// A wheel would meet an edge on its foot's way back to the neutral footprint.
     #[error(
-        "{leg:?}'s way back to the driving posture rolls over a {height_change_m:.3} m height change (at most {allowed_m:.3} m)"
+        "{leg:?}'s way back to the driving posture rolls its wheels over a {height_change_m:.3} m height change (at most {allowed_m:.3} m)"
     )]
     Edge {
         /// The leg.
         leg: Leg,
-        /// Height range of the terrain along the foot's way, m.
+        /// Height range over which a wheel of the pair rests along the foot's way, m.
         height_change_m: f64,
         /// The most a driving wheel meets, m.
         allowed_m: f64,

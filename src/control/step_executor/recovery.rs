@@ -1,10 +1,16 @@
 //! Leaving the plan: on a failure a lifted foot is put down first, then the robot returns
 //! to the driving posture at its pose (from the height map, feet rolled to the neutral
-//! footprint) and stops, so that `jobs::run` can replan. Where a foot would roll over an
-//! edge on its way back (a height change more than a driving wheel meets, as mid-flight
-//! on a staircase, where feet stand a tread apart), the robot holds its stance instead
-//! and reports itself stranded: rolling a wheel pair off a tread drops that corner, and
-//! on a stair descent the CoM stood 0.41 m outside the support for a second.
+//! footprint) and stops, so that `jobs::run` can replan. Where a wheel would meet an edge
+//! on its way back (a height change more than a driving wheel meets, as mid-flight on a
+//! staircase, where feet stand a tread apart), the robot holds its stance instead and
+//! reports itself stranded: rolling a wheel pair off a tread drops that corner, and on a
+//! stair descent the CoM stood 0.41 m outside the support for a second. The wheels are
+//! what meets an edge, not the foot's centre: each is the model's sphere, resting on the
+//! height map where it stands ([`HeightMap::wheel_rest_height`], risers counted), so a
+//! pair rolled toward a riser meets it a wheel radius before its centre's cell does. Checked
+//! under the foot's centre alone, a rear pair 0.7 cm short of a riser on a 14-step descent
+//! rolled 15 cm toward it, was driven into it (a target height 7 cm up the riser), and the
+//! robot bounced off its front pairs with the CoM 0.43 m outside the support.
 
 use super::drive::WHEEL_REST_RANGE_M;
 use super::timing::{motion_duration, smoothstep, smoothstep_rate};
@@ -13,7 +19,7 @@ use super::{
     planar,
 };
 use crate::motion::kinematics::{Posture, driving_posture, interpolate};
-use crate::robot::Leg;
+use crate::robot::{Leg, RobotDescription};
 use crate::terrain::HeightMap;
 
 impl StepExecutor {
@@ -53,7 +59,8 @@ impl StepExecutor {
         };
         for leg in Leg::ALL {
             let i = leg.index();
-            let height_change_m = height_range_along(ground, from.feet[i], to.feet[i]);
+            let height_change_m =
+                wheel_rest_range_along(&self.robot, ground, from.feet[i], to.feet[i]);
             if height_change_m > WHEEL_REST_RANGE_M {
                 let allowed_m = WHEEL_REST_RANGE_M;
                 let reason = Stranding::Edge { leg, height_change_m, allowed_m };
@@ -97,19 +104,38 @@ impl StepExecutor {
     }
 }
 
-/// Height range of the known terrain under a foot rolled in a straight line from `a` to
-/// `b` (sampled every half cell, both ends included), m: zero on flat ground, a tread's
-/// rise where the way crosses a stair edge.
-fn height_range_along(ground: &HeightMap, a: [f64; 3], b: [f64; 3]) -> f64 {
-    let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+/// The larger of the height ranges over which each wheel of a pair rests while the foot
+/// rolls in a straight line from `a` to `b` (sampled every half cell, both ends
+/// included), m: zero on flat ground and for a foot that does not move, a tread's rise
+/// where a wheel meets a stair edge. The pair rolls steered along its way, so its two
+/// wheels (the model's spheres, `track` apart) sit across it; each rests where
+/// [`HeightMap::wheel_rest_height`] puts it, with every cell counted (a riser is what the
+/// check is for). Samples where the map knows nothing under a wheel are left out.
+fn wheel_rest_range_along(
+    robot: &RobotDescription,
+    ground: &HeightMap,
+    a: [f64; 3],
+    b: [f64; 3],
+) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let length = dx.hypot(dy);
+    // Across the way (any direction for a foot that does not move).
+    let (ux, uy) = if length > 0.0 { (-dy / length, dx / length) } else { (0.0, 1.0) };
+    let half = robot.wheel_track / 2.0;
     let samples = (length / (0.5 * ground.resolution())).ceil().max(1.0) as usize;
-    let (lo, hi) = (0..=samples)
-        .filter_map(|k| {
-            let t = k as f64 / samples as f64;
-            ground.height_at_cell(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]))
+    [-half, half]
+        .map(|o| {
+            let (lo, hi) = (0..=samples)
+                .filter_map(|k| {
+                    let t = k as f64 / samples as f64;
+                    let (x, y) = (a[0] + t * dx + o * ux, a[1] + t * dy + o * uy);
+                    ground.wheel_rest_height(x, y, robot.wheel_radius, f64::INFINITY)
+                })
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)));
+            if lo <= hi { hi - lo } else { 0.0 }
         })
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)));
-    if lo <= hi { hi - lo } else { 0.0 }
+        .into_iter()
+        .fold(0.0, f64::max)
 }
 
 #[cfg(test)]
@@ -127,12 +153,25 @@ mod tests {
     }
 
     #[test]
-    fn the_height_range_along_a_foot_s_way_counts_the_edges_it_crosses() {
-        let step = map(Some(0.5));
-        assert_eq!(height_range_along(&step, [0.0, 0.0, 0.0], [0.4, 0.0, 0.0]), 0.0);
-        assert!((height_range_along(&step, [0.0, 0.0, 0.0], [1.0, 0.3, 0.0]) - 0.2).abs() < 1e-12);
-        // No way at all: the cell under the foot.
-        assert_eq!(height_range_along(&step, [0.6, 0.0, 0.2], [0.6, 0.0, 0.2]), 0.0);
+    fn the_wheels_way_back_counts_the_edges_they_meet() {
+        let (rb, step) = (robot(), map(Some(0.5)));
+        let range = |a: [f64; 2], b: [f64; 2]| {
+            wheel_rest_range_along(&rb, &step, [a[0], a[1], 0.0], [b[0], b[1], 0.0])
+        };
+        // Flat all the way: the wheels (radius 0.08 m) stop 0.02 m short of the edge.
+        assert_eq!(range([0.0, 0.0], [0.4, 0.0]), 0.0);
+        // Over the edge onto the 0.2 m block.
+        assert!((range([0.0, 0.0], [1.0, 0.3]) - 0.2).abs() < 1e-12);
+        // The foot's centre stops 0.03 m short of the edge, on the low cells all the way,
+        // but its wheels meet the block: each rests on the block's first cell, 0.03 m
+        // ahead, at 0.2 + √(0.08² − 0.03²) − 0.08 = 0.194162 m.
+        let short = range([0.0, 0.0], [0.47, 0.0]);
+        assert!(
+            (short - (0.2 + (0.08f64.powi(2) - 0.03f64.powi(2)).sqrt() - 0.08)).abs() < 1e-9,
+            "{short}"
+        );
+        // No way at all: where the wheels stand now.
+        assert_eq!(range([0.7, 0.0], [0.7, 0.0]), 0.0);
     }
 
     #[test]
@@ -159,5 +198,24 @@ mod tests {
             m => panic!("{m:?}"),
         }
         assert!(matches!(stance(ground(), 0.0), Mode::Recover { .. }));
+
+        // FL stands 0.1 m behind its neutral place, and a 0.2 m block's edge lies 3 to
+        // 5.5 cm ahead of that place (the next cell border): the foot's centre never
+        // leaves the low cells on its way back, but its wheels (radius 0.08 m) meet the
+        // block's first cell, `gap` ahead, and rest on it at 0.2 + √(0.08² − gap²) − 0.08.
+        let edge = ((neutral[0] + 2.03) / 0.025).ceil() * 0.025 - 2.0;
+        let gap = edge - neutral[0];
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), map(Some(edge)));
+        ex.cmd = standing();
+        ex.cmd.feet[0] = [neutral[0] - 0.1, neutral[1], 0.0];
+        ex.start_recover(failure.clone());
+        match ex.mode {
+            Mode::Stranded(_, Stranding::Edge { leg, height_change_m, .. }) => {
+                assert_eq!(leg, Leg::FrontLeft);
+                let rest = 0.2 + (0.08f64.powi(2) - gap * gap).sqrt() - 0.08;
+                assert!((height_change_m - rest).abs() < 1e-9, "{height_change_m} {rest}");
+            }
+            m => panic!("{m:?}"),
+        }
     }
 }
