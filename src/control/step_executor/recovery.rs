@@ -110,7 +110,9 @@ impl StepExecutor {
 /// where a wheel meets a stair edge. The pair rolls steered along its way, so its two
 /// wheels (the model's spheres, `track` apart) sit across it; each rests where
 /// [`HeightMap::wheel_rest_height`] puts it, with every cell counted (a riser is what the
-/// check is for). Samples where the map knows nothing under a wheel are left out.
+/// check is for). Samples where the map knows nothing under a wheel are left out. A wheel
+/// that already leans on a riser where it stands counts that riser too, even rolling away
+/// from it: the robot then holds its stance rather than move, the safe side of the check.
 fn wheel_rest_range_along(
     robot: &RobotDescription,
     ground: &HeightMap,
