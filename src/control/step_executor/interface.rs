@@ -63,10 +63,15 @@ pub struct ExecutorConfig {
     /// being the keyframes' base with the stabilising correction, clamped to this length.
     pub max_base_hold_m: f64,
     /// Stance offset from the plan's footholds beyond which the robot rolls back onto
-    /// them before a step, m (`step_executor::slide`): one cell of the height map
-    /// (`Params::grid_resolution_m`). The plan knows its footholds to a cell; a stance
-    /// within one of them stands where the plan checked it, and every slide moves
-    /// loaded pairs, which on a rolled base changes the wheel a pair rests on.
+    /// them before a step, m (`step_executor::slide`): half a cell of the height map
+    /// (`Params::grid_resolution_m` / 2), what one planned base shift's end cell moves the
+    /// footprint sideways at most. A stance off by more has gathered more than one shift's
+    /// rounding, and is rolled back while a roll still fits: on a tread a pair steered to
+    /// roll sideways swings its wheels along the fall line, and the further the stance
+    /// must go sideways, the longer the rolls. At one cell, a 14-step descent (0.17 m on
+    /// 0.28 m) planned 5.6° off the fall line had its sideways slides refused from 2 cm
+    /// on, drifted 14 cm to the side of its plan and left it two steps from the bottom;
+    /// at half a cell it descends (smallest margin 4.5 cm).
     pub slide_threshold_m: f64,
     /// Fastest stance slide, m/s.
     pub slide_speed_mps: f64,
@@ -152,7 +157,7 @@ impl ExecutorConfig {
             base_hold_gain: 2.0,
             max_base_lift_m: 0.04,
             max_base_hold_m: 0.04,
-            slide_threshold_m: params.grid_resolution_m,
+            slide_threshold_m: params.grid_resolution_m / 2.0,
             slide_speed_mps: 0.03,
             max_slide_s: 5.0,
             max_correction_m: 0.06,

@@ -24,7 +24,7 @@
 //! ([`StepExecutor::starts_a_step`]), the stance's error is measured from the wheel
 //! contacts MuJoCo reports ([`stance_error`]: each leg whose two wheels touch stands at
 //! their midpoint; the shift and turn that best take the footholds onto them). Where a
-//! foot stands more than [`ExecutorConfig::slide_threshold_m`] (a cell) from its foothold,
+//! foot stands more than [`ExecutorConfig::slide_threshold_m`] (half a cell) from its foothold,
 //! every pair steers to its own way back (the wheel kinematics of the body twist that
 //! turns and shifts the robot back; at most 90° of steering) and rolls, until the measured
 //! base pose has turned and moved by the error (closed loop on the base, pairs at most
@@ -467,7 +467,7 @@ impl StepExecutor {
                     Mode::Slide { index, start, rolls, roll: 0, elapsed: 0.0, rolling: true };
             }
             None => {
-                // Off by more than a cell with no roll that keeps the ground: said, so a
+                // Off by more than the threshold with no roll that keeps the ground: said, so a
                 // drift that builds up step by step on narrow treads is not silent.
                 if let Some(e) = err
                     && e.worst_m > self.config.slide_threshold_m
@@ -730,14 +730,18 @@ mod tests {
         // 3 cm behind and 3 cm to the left: the 3 cm along the heading.
         let r = shifts(&ex, [-0.03, 0.03]).unwrap();
         assert!(r.len() == 1 && close(r[0], [0.03, 0.0]), "{r:?}");
-        // 2 cm behind and 3 cm to the left: the 2 cm along are within a cell: no slide.
-        assert_eq!(shifts(&ex, [-0.02, 0.03]), None);
+        // 1 cm behind and 3 cm to the left: the 1 cm along is within the threshold (half
+        // a cell, 1.25 cm): no slide.
+        assert_eq!(shifts(&ex, [-0.01, 0.03]), None);
         // On open ground the whole offset in one roll.
         let ex = StepExecutor::new(&robot(), config(), step_path(), ground());
         let r = shifts(&ex, [-0.02, 0.03]).unwrap();
         assert!(r.len() == 1 && close(r[0], [0.02, -0.03]), "{r:?}");
-        // Within a cell (2.5 cm) nothing.
-        assert_eq!(shifts(&ex, [0.02, 0.01]), None);
+        // Within half a cell (1.25 cm) nothing; 2 cm behind and 1 cm to the left, which a
+        // threshold of a cell let be, rolled back.
+        assert_eq!(shifts(&ex, [0.01, 0.005]), None);
+        let r = shifts(&ex, [0.02, 0.01]).unwrap();
+        assert!(r.len() == 1 && close(r[0], [-0.02, -0.01]), "{r:?}");
     }
 
     /// The shifts of the rolls a slide makes for a stance shifted by `offset`, none of
@@ -941,17 +945,19 @@ mod tests {
             .collect();
         assert_eq!(refused.len(), 1, "{:?}", ex.events);
         assert!((refused[0].0 - 0.03).abs() < 1e-9 && (refused[0].1 - 0.03).abs() < 1e-9);
-        // Within a cell: nothing to report.
+        // Within the threshold: nothing to report.
         let mut ex = StepExecutor::new(&robot(), config(), step_path(), riser_from(0.45));
-        let o = obs(0.0, &ex, &two_wheel_contacts(&standing(), [0.02, 0.01]), [0.0; 3]);
+        let o = obs(0.0, &ex, &two_wheel_contacts(&standing(), [0.01, 0.005]), [0.0; 3]);
         ex.check_stance(1, &o);
         assert!(ex.events.is_empty(), "{:?}", ex.events);
     }
 
     #[test]
     fn feet_within_the_threshold_go_straight_to_the_guard() {
+        // Half a cell.
+        assert!((config().slide_threshold_m - 0.0125).abs() < 1e-12);
         let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
-        let o = obs(0.0, &ex, &two_wheel_contacts(&standing(), [0.02, 0.01]), [0.0; 3]);
+        let o = obs(0.0, &ex, &two_wheel_contacts(&standing(), [0.01, 0.005]), [0.0; 3]);
         ex.check_stance(1, &o);
         assert!(matches!(ex.mode, Mode::Guard { index: 1, .. }), "{:?}", ex.mode);
     }
