@@ -8,9 +8,9 @@
 //! what meets an edge, not the foot's centre: each is the model's sphere, resting on the
 //! height map where it stands ([`HeightMap::wheel_rest_height`], risers counted), so a
 //! pair rolled toward a riser meets it a wheel radius before its centre's cell does. Checked
-//! under the foot's centre alone, a rear pair 0.7 cm short of a riser on a 14-step descent
-//! rolled 15 cm toward it, was driven into it (a target height 7 cm up the riser), and the
-//! robot bounced off its front pairs with the CoM 0.43 m outside the support.
+//! under the foot's centre alone, a rear pair on a 14-step descent was rolled 15 cm toward
+//! a riser, to stop 0.7 cm short of it at a target height 7 cm up it, and the robot
+//! bounced off its front pairs with the CoM 0.43 m outside the support.
 
 use super::drive::WHEEL_REST_RANGE_M;
 use super::timing::{motion_duration, smoothstep, smoothstep_rate};
