@@ -24,14 +24,14 @@
 //! ([`StepExecutor::starts_a_step`]), the stance's error is measured from the wheel
 //! contacts MuJoCo reports ([`stance_error`]: each leg whose two wheels touch stands at
 //! their midpoint; the shift and turn that best take the footholds onto them). Where a
-//! foot stands more than [`ExecutorConfig::slide_threshold_m`] (half a cell) from its foothold,
-//! every pair steers to its own way back (the wheel kinematics of the body twist that
-//! turns and shifts the robot back; at most 90° of steering) and rolls, until the measured
-//! base pose has turned and moved by the error (closed loop on the base, pairs at most
-//! [`ExecutorConfig::slide_speed_mps`], given up after [`ExecutorConfig::max_slide_s`]);
-//! then the pairs steer straight again before the step's first segment. The legs keep
-//! their targets (the holds are frozen), so the relative geometry of base and feet does
-//! not change.
+//! foot stands more than [`ExecutorConfig::slide_threshold_m`] (half a cell) from its
+//! foothold, every pair steers to its own way back (the wheel kinematics of the body twist
+//! that turns and shifts the robot back; at most 90° of steering) and rolls, until the
+//! measured base pose has turned and moved by the error (closed loop on the base, pairs
+//! at most [`ExecutorConfig::slide_speed_mps`], given up after
+//! [`ExecutorConfig::max_slide_s`]); then the pairs steer straight again before the step's
+//! first segment. The legs keep their targets (the holds are frozen), so the relative
+//! geometry of base and feet does not change.
 //!
 //! A pair steered across its tread puts a wheel over the nosing or against the riser
 //! (measured: steering regardless, 4 of 30 generated flights aborted a step, 13 cm of
@@ -467,8 +467,8 @@ impl StepExecutor {
                     Mode::Slide { index, start, rolls, roll: 0, elapsed: 0.0, rolling: true };
             }
             None => {
-                // Off by more than the threshold with no roll that keeps the ground: said, so a
-                // drift that builds up step by step on narrow treads is not silent.
+                // Off by more than the threshold with no roll that keeps the ground: said,
+                // so a drift that builds up step by step on narrow treads is not silent.
                 if let Some(e) = err
                     && e.worst_m > self.config.slide_threshold_m
                 {
@@ -737,7 +737,7 @@ mod tests {
         let ex = StepExecutor::new(&robot(), config(), step_path(), ground());
         let r = shifts(&ex, [-0.02, 0.03]).unwrap();
         assert!(r.len() == 1 && close(r[0], [0.02, -0.03]), "{r:?}");
-        // Within half a cell (1.25 cm) nothing; 2 cm behind and 1 cm to the left, which a
+        // Within half a cell (1.25 cm) nothing; 2 cm ahead and 1 cm to the left, which a
         // threshold of a cell let be, rolled back.
         assert_eq!(shifts(&ex, [0.01, 0.005]), None);
         let r = shifts(&ex, [0.02, 0.01]).unwrap();
