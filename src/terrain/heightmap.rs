@@ -368,6 +368,18 @@ impl HeightMap {
     /// `max_top` are walls the wheel presses against, not tops it can roll onto: they are
     /// left out. `None` if no cell under the sphere is known.
     pub fn wheel_rest_height(&self, x: f64, y: f64, r: f64, max_top: f64) -> Option<f64> {
+        self.wheel_rest_height_on(x, y, r, |_, _, h| h <= max_top)
+    }
+
+    /// [`Self::wheel_rest_height`] on the known cells that `keep` (column, row, height)
+    /// accepts.
+    pub fn wheel_rest_height_on(
+        &self,
+        x: f64,
+        y: f64,
+        r: f64,
+        keep: impl Fn(usize, usize, f64) -> bool,
+    ) -> Option<f64> {
         let res = self.resolution;
         let span = |v: f64, o: f64, n: usize| {
             let lo = (((v - r - o) / res).floor().max(0.0)) as usize;
@@ -387,13 +399,23 @@ impl HeightMap {
                 if d2 > r * r {
                     continue;
                 }
-                if let Some(h) = self.get(i, j).filter(|&h| h <= max_top) {
+                if let Some(h) = self.get(i, j).filter(|&h| keep(i, j, h)) {
                     let z = h + (r * r - d2).sqrt() - r;
                     best = Some(best.map_or(z, |b: f64| b.max(z)));
                 }
             }
         }
         best
+    }
+
+    /// Whether cell (i, j), a square, comes within `r` of (x, y): the cells a sphere of
+    /// radius `r` centred above (x, y) may rest on ([`Self::wheel_rest_height`]).
+    pub fn cell_within(&self, i: usize, j: usize, x: f64, y: f64, r: f64) -> bool {
+        let res = self.resolution;
+        let (x0, y0) = (self.origin[0] + i as f64 * res, self.origin[1] + j as f64 * res);
+        let dx = (x0 - x).max(0.0).max(x - (x0 + res));
+        let dy = (y0 - y).max(0.0).max(y - (y0 + res));
+        dx * dx + dy * dy <= r * r
     }
 
     /// Highest known terrain over the cells whose centres lie within `radius` of the

@@ -110,9 +110,11 @@ impl StepExecutor {
 /// where a wheel meets a stair edge. The pair rolls steered along its way, so its two
 /// wheels (the model's spheres, `track` apart) sit across it; each rests where
 /// [`HeightMap::wheel_rest_height`] puts it, with every cell counted (a riser is what the
-/// check is for). Samples where the map knows nothing under a wheel are left out. A wheel
-/// that already leans on a riser where it stands counts that riser too, even rolling away
-/// from it: the robot then holds its stance rather than move, the safe side of the check.
+/// check is for) but those above its own cell that the wheel already touches where it
+/// stands: a pair that stepped up to a riser and rolls back from it leans on it, it does
+/// not meet it. The range includes the height of the wheel's own cell where it starts,
+/// so a wheel that starts at a drop and rolls off it counts the drop. Samples where the
+/// map knows nothing under a wheel are left out.
 fn wheel_rest_range_along(
     robot: &RobotDescription,
     ground: &HeightMap,
@@ -123,16 +125,24 @@ fn wheel_rest_range_along(
     let length = dx.hypot(dy);
     // Across the way (any direction for a foot that does not move).
     let (ux, uy) = if length > 0.0 { (-dy / length, dx / length) } else { (0.0, 1.0) };
-    let half = robot.wheel_track / 2.0;
+    let (half, r) = (robot.wheel_track / 2.0, robot.wheel_radius);
     let samples = (length / (0.5 * ground.resolution())).ceil().max(1.0) as usize;
     [-half, half]
         .map(|o| {
+            // Where the wheel stands: the height of its own cell, and the higher cells it
+            // already touches there, which it leans on rather than meets.
+            let (x0, y0) = (a[0] + o * ux, a[1] + o * uy);
+            let start = ground.height_at_cell(x0, y0);
+            let leaned_on = |i: usize, j: usize, h: f64| {
+                start.is_some_and(|s| h > s) && ground.cell_within(i, j, x0, y0, r)
+            };
             let (lo, hi) = (0..=samples)
                 .filter_map(|k| {
                     let t = k as f64 / samples as f64;
-                    let (x, y) = (a[0] + t * dx + o * ux, a[1] + t * dy + o * uy);
-                    ground.wheel_rest_height(x, y, robot.wheel_radius, f64::INFINITY)
+                    let (x, y) = (x0 + t * dx, y0 + t * dy);
+                    ground.wheel_rest_height_on(x, y, r, |i, j, h| !leaned_on(i, j, h))
                 })
+                .chain(start)
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)));
             if lo <= hi { hi - lo } else { 0.0 }
         })
@@ -174,6 +184,11 @@ mod tests {
         );
         // No way at all: where the wheels stand now.
         assert_eq!(range([0.7, 0.0], [0.7, 0.0]), 0.0);
+        // Wheels 5 cm short of the block lean on it (a pair that stepped up to a riser):
+        // rolled away from it they meet nothing.
+        assert_eq!(range([0.45, 0.0], [0.2, 0.0]), 0.0);
+        // Wheels 2 cm onto the block rolled off it: the drop counts from where they stand.
+        assert!((range([0.52, 0.0], [0.2, 0.0]) - 0.2).abs() < 1e-12);
     }
 
     #[test]
