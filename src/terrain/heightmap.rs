@@ -390,12 +390,8 @@ impl HeightMap {
         let (j0, j1) = span(y, self.origin[1], self.ny);
         let mut best: Option<f64> = None;
         for j in j0..=usize::try_from(j1).ok()? {
-            let y0 = self.origin[1] + j as f64 * res;
-            let dy = (y0 - y).max(0.0).max(y - (y0 + res));
             for i in i0..=usize::try_from(i1).ok()? {
-                let x0 = self.origin[0] + i as f64 * res;
-                let dx = (x0 - x).max(0.0).max(x - (x0 + res));
-                let d2 = dx * dx + dy * dy;
+                let d2 = self.cell_distance2(i, j, x, y);
                 if d2 > r * r {
                     continue;
                 }
@@ -411,11 +407,17 @@ impl HeightMap {
     /// Whether cell (i, j), a square, comes within `r` of (x, y): the cells a sphere of
     /// radius `r` centred above (x, y) may rest on ([`Self::wheel_rest_height`]).
     pub fn cell_within(&self, i: usize, j: usize, x: f64, y: f64, r: f64) -> bool {
+        self.cell_distance2(i, j, x, y) <= r * r
+    }
+
+    /// Squared horizontal distance from (x, y) to the nearest point of cell (i, j), a
+    /// square, m².
+    fn cell_distance2(&self, i: usize, j: usize, x: f64, y: f64) -> f64 {
         let res = self.resolution;
         let (x0, y0) = (self.origin[0] + i as f64 * res, self.origin[1] + j as f64 * res);
         let dx = (x0 - x).max(0.0).max(x - (x0 + res));
         let dy = (y0 - y).max(0.0).max(y - (y0 + res));
-        dx * dx + dy * dy <= r * r
+        dx * dx + dy * dy
     }
 
     /// Highest known terrain over the cells whose centres lie within `radius` of the

@@ -348,13 +348,14 @@ impl StepExecutor {
         (!rolls.is_empty()).then_some(rolls)
     }
 
-    /// The rolls that turn the stance `from` (fitted and measured feet, one base) by `turn` (rad)
-    /// about `centre`: the turn on the spot if the pairs can steer to it (each pair across its
-    /// radius, 40–50° from the heading); else two arcs of half the turn each, about centres
-    /// [`TURN_ARC_RADII`] to either side (the first arc forward and the second backward, or the
-    /// other way, like a three-point turn), with the smallest radius whose steering keeps the
-    /// ground: at radius R a pair steers about atan(0.35 / (R − 0.32)) from the heading and the
-    /// stance rolls turn · R / 2 along it and back. None where nothing keeps the ground.
+    /// The rolls that turn the stance `from` (fitted and measured feet, one base) by
+    /// `turn` (rad) about `centre`: the turn on the spot if the pairs can steer to it
+    /// (each pair across its radius, 40–50° from the heading); else two arcs of half the
+    /// turn each, about centres [`TURN_ARC_RADII`] to either side (the first arc forward
+    /// and the second backward, or the other way, like a three-point turn), with the
+    /// smallest radius whose steering keeps the ground: at radius R a pair steers about
+    /// atan(0.35 / (R − 0.32)) from the heading and the stance rolls turn · R / 2 along it
+    /// and back. None where nothing keeps the ground.
     fn turn_rolls(&self, from: &[Posture; 2], centre: [f64; 2], turn: f64) -> Vec<Roll> {
         let on_the_spot = Roll { centre, turn, shift: [0.0; 2] };
         if self.rolls_keep_the_ground(from, &[on_the_spot]) {
@@ -389,12 +390,13 @@ impl StepExecutor {
         Vec::new()
     }
 
-    /// The rolls that shift the stance `from` (fitted and measured feet, one base) by `back`
-    /// (world, m): all of it in one roll if the pairs can steer to it; else its sideways part in
-    /// two rolls at the largest of [`ZIGZAG_ANGLES`] from the heading that the pairs can steer to
-    /// (one forward, one backward, their parts along the heading adding up to the shift's, in the
-    /// order that keeps the ground); else its part along the heading (rolled straight, over
-    /// footholds the plan checked) if that is more than the threshold; else none.
+    /// The rolls that shift the stance `from` (fitted and measured feet, one base) by
+    /// `back` (world, m): all of it in one roll if the pairs can steer to it; else its
+    /// sideways part in two rolls at the largest of [`ZIGZAG_ANGLES`] from the heading
+    /// that the pairs can steer to (one forward, one backward, their parts along the
+    /// heading adding up to the shift's, in the order that keeps the ground); else its
+    /// part along the heading (rolled straight, over footholds the plan checked) if that
+    /// is more than the threshold; else none.
     fn shift_rolls(&self, from: &[Posture; 2], back: [f64; 2]) -> Vec<Roll> {
         let threshold = self.config.slide_threshold_m;
         if back[0].hypot(back[1]) <= threshold {
