@@ -159,7 +159,7 @@ use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, e
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{STEP_HEIGHT_TOLERANCE_M, StepBound, StepBoundParams};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
-use super::reachability::BaseRegions;
+use super::reachability::{BaseRegions, StanceLimits};
 use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
@@ -758,10 +758,32 @@ impl<'c> HybridGraph<'c> {
             self.maps,
             &self.robot,
             &self.lattice,
-            config.motion.base_circle_radius_m,
+            (config.motion.base_circle_radius_m, &self.stance_limits()),
             (goal.i, goal.j),
         );
         HeuristicTables { regions, step_bound, cost_to_go, setup: t0.elapsed() }
+    }
+
+    /// How high any state's hips and base stand above its feet (`reachability`): the
+    /// standing rule's tallest leg height and pitch fraction, and the mean front feet's
+    /// least lead over the mean rear feet: each side's front foot stands at least half
+    /// the support length ahead of its rear foot ([`Self::sides_ok`]; neutral states a hip
+    /// spacing), or the legs' reach limits, whichever says more.
+    fn stance_limits(&self) -> StanceLimits {
+        let res = self.lattice.resolution;
+        let x = |k: usize, o: i8| {
+            self.robot.hips[k][0] + self.robot.neutral_foot_offset_x[k] + f64::from(o) * res
+        };
+        let [fl, fr, rl, rr] = self.reach;
+        let reach = (x(0, fl[0]) + x(1, fr[0]) - x(2, rl[1]) - x(3, rr[1])) / 2.0;
+        let sides = 0.5 * self.config.min_support_side_length_m;
+        let spread = reach.max(sides.min(self.side_length(&[0; 4], true)));
+        let standing = &self.config.motion.standing;
+        StanceLimits {
+            leg_height_m: standing.leg_height_m.max(self.config.motion.driving_leg_height_m),
+            pitch_fraction: standing.pitch_fraction,
+            min_feet_spread_m: spread,
+        }
     }
 
     /// Whether the heuristic's tables have been built (by a first heuristic query).

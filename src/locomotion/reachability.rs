@@ -9,20 +9,35 @@
 //! - the underside of the base clears the terrain under its two circles
 //!   (`DrivingCheck::body_clear`): here, the highest terrain within
 //!   [`BODY_DISC_M`] of each circle centre (less than the 0.25 m the check uses, for the
-//!   base's offset from its cell centre during a base shift) is at most
-//!   `H_loc + `[`BODY_RISE_M`];
+//!   base's offset from its cell centre during a base shift) is at most `H_hi` plus the
+//!   body's rise bound below;
 //! - the first quarter of every thigh clears the (dilated) leg terrain by 4 cm
 //!   (`StandingRule::legs_clear`): here, somewhere in a band of the hip's sagittal plane
 //!   around its nominal position (where that point lies, whatever the hip angle, pitch
 //!   or offset of the base: 12.5 cm along, 2.5 cm across) the leg terrain is at most
-//!   `H_loc + `[`HIP_RISE_M`].
+//!   `H_hi` plus the hip's rise bound below.
 //!
-//! `H_loc` is the highest ground of finite foot cost within [`FEET_REACH_M`] of the cell:
-//! every foot stands on such ground within that distance of the base. The standing rule
-//! puts the hip over the highest foot at most 0.45 m above it, and the pitch (70 % of
-//! the slope between the front and rear feet) raises another hip by at most
-//! 0.7 m · sin 0.4 ≈ 0.27 m; so no hip, thigh point or base underside is more than
-//! 0.72 m above `H_loc`, and the rises below leave 0.1 m to spare.
+//! **How high the base stands** ([`StanceLimits`]). Every foot of every state stands on
+//! a cell of finite foot cost within [`FEET_REACH_M`] of the base cell, so its ground
+//! lies in `[H_lo, H_hi]`, the lowest and highest such ground near the cell (a square
+//! window holding that disc: a larger window only weakens the test). Both postures a
+//! state stands in (the driving posture and the standing rule's) set the base by the
+//! same rule (`motion::standing::base_z`): pitched by `p`, raised until every hip stands
+//! at least the leg height `h` above its foot's ground `g_j`, one exactly; so hip `i`
+//! stands at `max_j (g_j + h + sin p · x_j) − sin p · x_i ≤ H_hi + h + |sin p| · (max x −
+//! min x)` (x the hips' x' in the base frame, their z' all one; roll is zero; a spread
+//! of the hips' z' is added where they differ), and a point a quarter thigh along its
+//! leg at most `thigh / 4` higher. The base's underside at a circle centre c stands at
+//! most `H_hi + h + |sin p| · (max |x_j| + |c|) + max(b, b cos p)` (b the underside's
+//! height above the hip axes). The pitch is
+//! `pitch_fraction · atan(dz / dx)` of the mean front and rear feet, `|dz| ≤ H_hi − H_lo`
+//! and `dx` at least [`StanceLimits::min_feet_spread_m`] over the planner's foot offsets;
+//! `h` at most the standing rule's soft constraint (0.45 m; driving stands at 0.27 m).
+//! On level ground (`H_lo = H_hi`) the pitch is zero and a hip stands at most 0.45 m up:
+//! a wall of 0.65 m closes a doorway narrower than the hips' 0.64 m track, which a fixed
+//! allowance for a pitch of 0.4 rad (0.72 m, 0.85 m with 0.13 m to spare, as this test
+//! had it) left open, and the search took 1.1 M expansions (18 s) to prove it. The
+//! bounds leave the 4 cm leg and 2 cm body clearances as spare.
 //!
 //! **Regions.** The test is made per cell *and orientation*. Admissible (cell,
 //! orientation) pairs at most [`LINK_CELLS`] apart along each axis in the same
@@ -43,6 +58,7 @@ use super::lattice::Lattice;
 use crate::cost::{CostMaps, DiscMaxLayer};
 use crate::robot::RobotDescription;
 use crate::terrain::HeightMap;
+use std::f64::consts::FRAC_PI_2;
 
 /// Radius around each base circle centre whose terrain the base must clear, m.
 pub const BODY_DISC_M: f64 = 0.2;
@@ -54,15 +70,71 @@ const HIP_BAND_X: [f64; 8] = [0.0, 0.025, 0.05, 0.075, 0.1, -0.025, -0.05, 0.125
 /// Lateral offsets (base frame y') of that point, m: the thigh stays in its leg's plane
 /// (the roll of a step moves it under 1 cm); one cell either way for the base's offset.
 const HIP_BAND_Y: [f64; 3] = [0.0, -0.025, 0.025];
-/// Highest terrain under the base circles above `H_loc`, m.
-pub const BODY_RISE_M: f64 = 0.85;
-/// Highest leg terrain at a hip's thigh point above `H_loc`, m.
-pub const HIP_RISE_M: f64 = 0.85;
 /// Farthest a foot stands from the base centre, m (the neutral foot 0.47 m out, plus
 /// the largest foot offset).
 pub const FEET_REACH_M: f64 = 1.0;
 /// Link radius between admissible cells, cells.
 pub const LINK_CELLS: isize = 2;
+
+/// What bounds how high a state's hips and base stand above its feet (see the module
+/// docs): the standing rule's tallest leg height and pitch fraction, and how far apart
+/// the front and rear feet stand at the least.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StanceLimits {
+    /// Tallest leg height of any state's posture (`StandingRule::leg_height_m`), m.
+    pub leg_height_m: f64,
+    /// Base pitch as a fraction of the feet's slope (`StandingRule::pitch_fraction`).
+    pub pitch_fraction: f64,
+    /// Smallest distance along the heading from the mean rear to the mean front foot over
+    /// every footprint the planner admits, m; at most zero where the feet could stand
+    /// level with each other (then only the fraction of a right angle bounds the pitch).
+    pub min_feet_spread_m: f64,
+}
+
+/// How far above `H_hi` a cell's tests look (see the module docs), m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Rises {
+    /// A thigh's first checked point.
+    hip: f64,
+    /// The base's underside at a circle centre.
+    body: f64,
+}
+
+impl StanceLimits {
+    /// The largest base pitch of a posture whose feet stand on ground at most `span`
+    /// apart in height, rad.
+    fn max_pitch(&self, span: f64) -> f64 {
+        if span <= 0.0 {
+            return 0.0;
+        }
+        let slope = if self.min_feet_spread_m > 0.0 {
+            (span / self.min_feet_spread_m).atan()
+        } else {
+            FRAC_PI_2
+        };
+        (self.pitch_fraction.abs() * slope).min(FRAC_PI_2)
+    }
+
+    /// The rises over `H_hi` for feet on ground at most `span` apart in height.
+    fn rises(&self, robot: &RobotDescription, circles_x: [f64; 2], span: f64) -> Rises {
+        let p = self.max_pitch(span);
+        let (sin, cos) = (p.sin(), p.cos());
+        let xs = robot.hips.map(|h| h[0]);
+        let (lo, hi) =
+            xs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        let far = xs.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let c = circles_x.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let b = robot.base_bottom_z;
+        // Zero for a model whose hip axes share one height (Momaro's do).
+        let zs = robot.hips.map(|h| h[2]);
+        let tilt = zs.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - zs.iter().copied().fold(f64::INFINITY, f64::min);
+        Rises {
+            hip: self.leg_height_m + sin * (hi - lo) + tilt + robot.thigh_length / 4.0,
+            body: self.leg_height_m + sin * (far + c) + tilt + b.max(b * cos),
+        }
+    }
+}
 
 /// Most words a cell's orientation set takes: the lattice has at most 256 orientations.
 const MAX_WORDS: usize = 4;
@@ -197,15 +269,16 @@ impl BaseRegions {
         Self { nx: 0, region: Vec::new(), goal_region: None, regions: 0 }
     }
 
-    /// Builds the regions on `maps` for a lattice `lattice` and the goal cell.
+    /// Builds the regions on `maps` for a lattice `lattice` and the goal cell, for a
+    /// robot standing within `limits`.
     pub fn build(
         maps: &CostMaps,
         robot: &RobotDescription,
         lattice: &Lattice,
-        circle_radius_m: f64,
+        (circle_radius_m, limits): (f64, &StanceLimits),
         goal: (i16, i16),
     ) -> Self {
-        let Some(ok) = admissible(maps, robot, lattice, circle_radius_m) else {
+        let Some(ok) = admissible(maps, robot, lattice, circle_radius_m, limits) else {
             return Self::off();
         };
         let (nx, ny) = maps.heights().dims();
@@ -263,10 +336,10 @@ impl BaseRegions {
     }
 }
 
-/// `H_loc` per cell: the highest standable ground near it (a square window holding the
-/// disc of [`FEET_REACH_M`]: a larger window only weakens the test); not standable =
-/// unknown (NaN). `None` if the map cannot be built.
-fn highest_standable_near(maps: &CostMaps) -> Option<HeightMap> {
+/// `H_lo` and `H_hi` per cell: the lowest and highest standable ground near it (a square
+/// window holding the disc of [`FEET_REACH_M`]: a larger window only weakens the test);
+/// none standable = unknown (NaN). `None` if the maps cannot be built.
+fn standable_range_near(maps: &CostMaps) -> Option<(HeightMap, HeightMap)> {
     let hm = maps.heights();
     let (nx, ny) = hm.dims();
     let res = hm.resolution();
@@ -276,8 +349,12 @@ fn highest_standable_near(maps: &CostMaps) -> Option<HeightMap> {
             _ => f64::NAN,
         })
         .collect();
-    let standable = HeightMap::new(hm.origin(), res, nx, ny, standable).ok()?;
-    Some(standable.dilated_max((FEET_REACH_M / res).ceil() as usize))
+    let window = (FEET_REACH_M / res).ceil() as usize;
+    let negated = standable.iter().map(|h| -h).collect();
+    let high = HeightMap::new(hm.origin(), res, nx, ny, standable).ok()?.dilated_max(window);
+    let low = HeightMap::new(hm.origin(), res, nx, ny, negated).ok()?.dilated_max(window);
+    let low = low.as_slice().iter().map(|h| -h).collect();
+    Some((HeightMap::new(hm.origin(), res, nx, ny, low).ok()?, high))
 }
 
 /// The admissible (cell, orientation) pairs (see the module's doc); `None` if the map
@@ -287,12 +364,14 @@ fn admissible(
     robot: &RobotDescription,
     lattice: &Lattice,
     circle_radius_m: f64,
+    limits: &StanceLimits,
 ) -> Option<OrientationSets> {
     let hm = maps.heights();
     let (nx, ny) = hm.dims();
     let res = hm.resolution();
-    let h_loc = highest_standable_near(maps)?;
-    let h_loc = h_loc.as_slice();
+    let (low, high) = standable_range_near(maps)?;
+    let (low, high) = (low.as_slice(), high.as_slice());
+    let circles_x = robot.base_circle_centres_x(circle_radius_m);
     let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
     let legs = maps.leg_terrain();
     let no = usize::from(lattice.orientations);
@@ -309,15 +388,16 @@ fn admissible(
     for j in 0..ny {
         for i in 0..nx {
             let k = j * nx + i;
-            let top = h_loc[k];
+            let top = high[k];
             if !top.is_finite() {
                 continue;
             }
+            let rise = limits.rises(robot, circles_x, top - low[k]);
             for (o, probe) in probes.iter().enumerate() {
                 let body_ok = probe.body.iter().all(|&d| {
                     shifted(i, j, d)
                         .and_then(|(a, b)| body.get(a, b))
-                        .is_some_and(|h| h <= top + BODY_RISE_M)
+                        .is_some_and(|h| h <= top + rise.body)
                 });
                 // Unknown or off the map: `legs_clear` lets it pass too.
                 let legs_ok = || {
@@ -325,7 +405,7 @@ fn admissible(
                         band.iter().any(|&d| {
                             shifted(i, j, d)
                                 .and_then(|(a, b)| legs.get(a, b))
-                                .is_none_or(|h| h <= top + HIP_RISE_M)
+                                .is_none_or(|h| h <= top + rise.hip)
                         })
                     })
                 };
@@ -345,6 +425,11 @@ mod tests {
     use crate::scenario::Primitive;
     use crate::terrain::rasterise;
 
+    /// The paper's standing rule (0.45 m legs, 70 % of the slope) with the front feet at
+    /// least 0.3 m ahead of the rear ones.
+    const LIMITS: StanceLimits =
+        StanceLimits { leg_height_m: 0.45, pitch_fraction: 0.7, min_feet_spread_m: 0.3 };
+
     /// The cost maps and lattice of `prims` on a 6 m × 4 m map, with the reference robot.
     fn world(prims: &[Primitive]) -> (CostMaps, RobotDescription, Lattice) {
         let robot = RobotDescription::reference();
@@ -360,7 +445,7 @@ mod tests {
             let s = lattice.state(&crate::geometry::Pose2::new(p[0], p[1], 0.0)).unwrap();
             (s.i, s.j)
         };
-        let r = BaseRegions::build(&maps, &robot, &lattice, 0.25, cell(goal));
+        let r = BaseRegions::build(&maps, &robot, &lattice, (0.25, &LIMITS), cell(goal));
         (r, lattice)
     }
 
@@ -408,14 +493,71 @@ mod tests {
     }
 
     #[test]
-    fn a_platform_or_a_low_bar_stays_open() {
-        // Steps and straddling are possible over a 0.3 m platform and a 0.5 m bar.
+    fn a_platform_or_a_bar_under_the_base_stays_open() {
+        // Steps over a 0.3 m platform; the base's underside stands up to 0.45 m over the
+        // floor, so a 0.4 m bar passes under it in the relaxation. (A 0.5 m bar, which
+        // this test once kept open, is closed: no state's base clears it, and the step
+        // bound already refused it, 0.2 m above the largest step.)
         let prims = [
             Primitive::Box { center: [2.0, 0.0], size: [1.0, 4.0], height: 0.3, yaw_deg: 0.0 },
-            Primitive::Box { center: [3.6, 0.0], size: [0.1, 4.0], height: 0.5, yaw_deg: 0.0 },
+            Primitive::Box { center: [3.6, 0.0], size: [0.1, 4.0], height: 0.4, yaw_deg: 0.0 },
         ];
         let (r, l) = regions(&prims, [4.5, 0.0]);
         assert!(goal_reachable(&r, &l, [0.0, 0.0]));
+    }
+
+    #[test]
+    fn a_doorway_between_the_hips_is_closed_by_a_wall_above_them() {
+        // `impossible_009107` (generated): a 0.42 m doorway in a 0.11 m wall, narrower
+        // than the hips' 0.64 m track. At 0.67 m the wall stands above every hip on level
+        // ground (0.45 m legs, no pitch): closed, where a fixed allowance for a 0.4 rad
+        // pitch (0.85 m) let the hips pass one by one through the gap while the base
+        // crabbed across it, and the search took 1.1 M expansions to prove it. At 0.35 m
+        // the thighs pass over the wall: open.
+        let door = |height: f64| {
+            let (gap, w) = (0.42, (4.0 - 0.42) / 2.0);
+            [
+                Primitive::Box {
+                    center: [2.0, gap / 2.0 + w / 2.0],
+                    size: [0.11, w],
+                    height,
+                    yaw_deg: 0.0,
+                },
+                Primitive::Box {
+                    center: [2.0, -gap / 2.0 - w / 2.0],
+                    size: [0.11, w],
+                    height,
+                    yaw_deg: 0.0,
+                },
+            ]
+        };
+        let (r, l) = regions(&door(0.67), [4.0, 0.0]);
+        assert!(r.is_on());
+        assert!(!goal_reachable(&r, &l, [0.0, 0.0]), "0.67 m wall");
+        let (r, l) = regions(&door(0.35), [4.0, 0.0]);
+        assert!(goal_reachable(&r, &l, [0.0, 0.0]), "0.35 m wall");
+    }
+
+    #[test]
+    fn the_rises_follow_the_pitch_the_feet_allow() {
+        let robot = RobotDescription::reference();
+        let circles = robot.base_circle_centres_x(0.25);
+        // Level ground: no pitch; the leg height, plus a quarter thigh for the hip's
+        // first point (0.45 + 0.25 / 4), and the underside at the hip axes.
+        let level = LIMITS.rises(&robot, circles, 0.0);
+        assert!((level.hip - 0.5125).abs() < 1e-12, "{level:?}");
+        assert!((level.body - 0.45).abs() < 1e-12, "{level:?}");
+        // 0.2 m of height within reach, feet 0.3 m apart: p = 0.7 · atan(0.2 / 0.3) =
+        // 0.411602 rad, sin p = 0.400078; hips 0.7 m apart along x', the farthest 0.35 m
+        // out and the circles 0.2 m: 0.45 + 0.7 sin p + 0.0625 and 0.45 + 0.55 sin p.
+        let steep = LIMITS.rises(&robot, circles, 0.2);
+        assert!((steep.hip - 0.792_554_5).abs() < 1e-6, "{steep:?}");
+        assert!((steep.body - 0.670_042_8).abs() < 1e-6, "{steep:?}");
+        // Feet that could stand level with each other: the pitch is only bounded by 70 %
+        // of a right angle, unless the ground is level.
+        let free = StanceLimits { min_feet_spread_m: 0.0, ..LIMITS };
+        assert_eq!(free.max_pitch(0.0), 0.0);
+        assert!((free.max_pitch(0.01) - 0.7 * FRAC_PI_2).abs() < 1e-12);
     }
 
     /// The admissibility test as the module's doc states it, in world coordinates: each
@@ -428,30 +570,32 @@ mod tests {
     ) -> Vec<bool> {
         let hm = maps.heights();
         let (nx, ny) = hm.dims();
-        let h_loc = highest_standable_near(maps).unwrap();
+        let (low, high) = standable_range_near(maps).unwrap();
         let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
         let legs = maps.leg_terrain();
         let no = usize::from(lattice.orientations);
         let mut out = vec![false; nx * ny * no];
         for (n, out) in out.iter_mut().enumerate() {
             let (k, o) = (n / no, n % no);
-            let top = h_loc.as_slice()[k];
+            let top = high.as_slice()[k];
             if !top.is_finite() {
                 continue;
             }
+            let rise =
+                LIMITS.rises(robot, robot.base_circle_centres_x(0.25), top - low.as_slice()[k]);
             let [x, y] = hm.cell_center(k % nx, k / nx);
             let (s, c) = lattice.yaw(o as u8).sin_cos();
             let body_ok = robot.base_circle_centres_x(0.25).iter().all(|&cx| {
                 hm.cell_of(x + c * cx, y + s * cx)
                     .and_then(|(a, b)| body.get(a, b))
-                    .is_some_and(|h| h <= top + BODY_RISE_M)
+                    .is_some_and(|h| h <= top + rise.body)
             });
             let legs_ok = robot.hips.iter().all(|hp| {
                 HIP_BAND_X.iter().any(|dx| {
                     HIP_BAND_Y.iter().any(|dy| {
                         let (bx, by) = (hp[0] - hp[0].signum() * dx, hp[1] + dy);
                         legs.height_at_cell(x + c * bx - s * by, y + s * bx + c * by)
-                            .is_none_or(|h| h <= top + HIP_RISE_M)
+                            .is_none_or(|h| h <= top + rise.hip)
                     })
                 })
             });
@@ -504,7 +648,8 @@ mod tests {
         let (nx, ny) = maps.heights().dims();
         let no = usize::from(lattice.orientations);
         let goal = lattice.state(&crate::geometry::Pose2::new(4.3, 1.0, 0.0)).unwrap();
-        let regions = BaseRegions::build(&maps, &robot, &lattice, 0.25, (goal.i, goal.j));
+        let regions =
+            BaseRegions::build(&maps, &robot, &lattice, (0.25, &LIMITS), (goal.i, goal.j));
         // Reference: breadth-first over (cell, orientation) pairs of the defining test.
         let ok = admissible_by_definition(&maps, &robot, &lattice);
         let g = goal.j as usize * nx + goal.i as usize;
@@ -543,7 +688,7 @@ mod tests {
     #[test]
     fn the_cell_shift_scan_matches_the_tests_definition() {
         let (maps, robot, lattice) = odd_terrain();
-        let scan = admissible(&maps, &robot, &lattice, 0.25).unwrap();
+        let scan = admissible(&maps, &robot, &lattice, 0.25, &LIMITS).unwrap();
         let reference = admissible_by_definition(&maps, &robot, &lattice);
         let no = usize::from(lattice.orientations);
         let differing =
