@@ -319,6 +319,20 @@ impl StepBound {
         sum
     }
 
+    /// Whether some foot standing on cell `k` (row-major) could still reach its goal
+    /// component, so that a state with a foot there can reach the goal at all: every cell
+    /// where the bound is off, none of non-finite foot cost. A foot on any other cell
+    /// makes [`Self::lower_bound`] infinite.
+    pub fn live(&self, k: usize) -> bool {
+        if self.components == 0 {
+            return true;
+        }
+        self.comp.get(k).is_some_and(|&c| {
+            c != NONE
+                && self.per_foot.iter().any(|s| s.get(c as usize).is_some_and(|v| !v.is_infinite()))
+        })
+    }
+
     /// The foot-offset potential Φ = c · Σ_k (o_k⁻ − o_k⁺) of a footprint with offsets
     /// `o` (cells; o⁻ = max(−o, 0), o⁺ = max(o, 0)), as its two parts `(c · Σ o⁻,
     /// c · Σ o⁺)`: the heuristic adds the first and subtracts the second (see

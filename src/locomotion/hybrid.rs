@@ -758,7 +758,7 @@ impl<'c> HybridGraph<'c> {
             self.maps,
             &self.robot,
             &self.lattice,
-            (config.motion.base_circle_radius_m, &self.stance_limits()),
+            (config.motion.base_circle_radius_m, &self.stance_limits(), &step_bound),
             (goal.i, goal.j),
         );
         HeuristicTables { regions, step_bound, cost_to_go, setup: t0.elapsed() }

@@ -18,9 +18,14 @@
 //!   `H_hi` plus the hip's rise bound below.
 //!
 //! **How high the base stands** ([`StanceLimits`]). Every foot of every state stands on
-//! a cell of finite foot cost within [`FEET_REACH_M`] of the base cell, so its ground
-//! lies in `[H_lo, H_hi]`, the lowest and highest such ground near the cell (a square
-//! window holding that disc: a larger window only weakens the test). Both postures a
+//! a cell of finite foot cost within [`FEET_REACH_M`] of the base cell, and every foot of
+//! a state that can reach the goal on one from which the step bound (`heuristic`) lets
+//! it reach its own goal component (elsewhere the heuristic is infinite anyway: the top
+//! of a wall 0.29 m thick, whose middle lies more than r_F from its edges, is no ground
+//! here). So its ground lies in `[H_lo, H_hi]`, the lowest and highest such ground near
+//! the cell (a square window holding that disc: a larger window only weakens the test).
+//! A state with no such foot is cut off from the goal whatever the regions say, so the
+//! flood below only needs to be right for the others. Both postures a
 //! state stands in (the driving posture and the standing rule's) set the base by the
 //! same rule (`motion::standing::base_z`): pitched by `p`, raised until every hip stands
 //! at least the leg height `h` above its foot's ground `g_j`, one exactly; so hip `i`
@@ -54,6 +59,7 @@
 //! counts as reachable), and a cell that is not admissible itself (only ever a start
 //! the robot was put in) counts as reachable: the search from it goes on as before.
 
+use super::heuristic::StepBound;
 use super::lattice::Lattice;
 use crate::cost::{CostMaps, DiscMaxLayer};
 use crate::robot::RobotDescription;
@@ -270,15 +276,16 @@ impl BaseRegions {
     }
 
     /// Builds the regions on `maps` for a lattice `lattice` and the goal cell, for a
-    /// robot standing within `limits`.
+    /// robot standing within `limits` on ground that `steps` lets a foot reach the goal
+    /// from.
     pub fn build(
         maps: &CostMaps,
         robot: &RobotDescription,
         lattice: &Lattice,
-        (circle_radius_m, limits): (f64, &StanceLimits),
+        (circle_radius_m, limits, steps): (f64, &StanceLimits, &StepBound),
         goal: (i16, i16),
     ) -> Self {
-        let Some(ok) = admissible(maps, robot, lattice, circle_radius_m, limits) else {
+        let Some(ok) = admissible(maps, robot, lattice, circle_radius_m, (limits, steps)) else {
             return Self::off();
         };
         let (nx, ny) = maps.heights().dims();
@@ -337,15 +344,17 @@ impl BaseRegions {
 }
 
 /// `H_lo` and `H_hi` per cell: the lowest and highest standable ground near it (a square
-/// window holding the disc of [`FEET_REACH_M`]: a larger window only weakens the test);
-/// none standable = unknown (NaN). `None` if the maps cannot be built.
-fn standable_range_near(maps: &CostMaps) -> Option<(HeightMap, HeightMap)> {
+/// window holding the disc of [`FEET_REACH_M`]: a larger window only weakens the test):
+/// cells of finite foot cost from which `steps` lets a foot still reach its goal (a
+/// state with a foot anywhere else has an infinite heuristic, so no path to the goal
+/// stands on it); none standable = unknown (NaN). `None` if the maps cannot be built.
+fn standable_range_near(maps: &CostMaps, steps: &StepBound) -> Option<(HeightMap, HeightMap)> {
     let hm = maps.heights();
     let (nx, ny) = hm.dims();
     let res = hm.resolution();
     let standable: Vec<f64> = (0..nx * ny)
         .map(|k| match (maps.foot_cost_cell(k % nx, k / nx).finite(), hm.as_slice()[k]) {
-            (Some(_), h) if h.is_finite() => h,
+            (Some(_), h) if h.is_finite() && steps.live(k) => h,
             _ => f64::NAN,
         })
         .collect();
@@ -364,12 +373,12 @@ fn admissible(
     robot: &RobotDescription,
     lattice: &Lattice,
     circle_radius_m: f64,
-    limits: &StanceLimits,
+    (limits, steps): (&StanceLimits, &StepBound),
 ) -> Option<OrientationSets> {
     let hm = maps.heights();
     let (nx, ny) = hm.dims();
     let res = hm.resolution();
-    let (low, high) = standable_range_near(maps)?;
+    let (low, high) = standable_range_near(maps, steps)?;
     let (low, high) = (low.as_slice(), high.as_slice());
     let circles_x = robot.base_circle_centres_x(circle_radius_m);
     let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
@@ -445,7 +454,13 @@ mod tests {
             let s = lattice.state(&crate::geometry::Pose2::new(p[0], p[1], 0.0)).unwrap();
             (s.i, s.j)
         };
-        let r = BaseRegions::build(&maps, &robot, &lattice, (0.25, &LIMITS), cell(goal));
+        let r = BaseRegions::build(
+            &maps,
+            &robot,
+            &lattice,
+            (0.25, &LIMITS, &StepBound::zero()),
+            cell(goal),
+        );
         (r, lattice)
     }
 
@@ -570,7 +585,7 @@ mod tests {
     ) -> Vec<bool> {
         let hm = maps.heights();
         let (nx, ny) = hm.dims();
-        let (low, high) = standable_range_near(maps).unwrap();
+        let (low, high) = standable_range_near(maps, &StepBound::zero()).unwrap();
         let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
         let legs = maps.leg_terrain();
         let no = usize::from(lattice.orientations);
@@ -648,8 +663,13 @@ mod tests {
         let (nx, ny) = maps.heights().dims();
         let no = usize::from(lattice.orientations);
         let goal = lattice.state(&crate::geometry::Pose2::new(4.3, 1.0, 0.0)).unwrap();
-        let regions =
-            BaseRegions::build(&maps, &robot, &lattice, (0.25, &LIMITS), (goal.i, goal.j));
+        let regions = BaseRegions::build(
+            &maps,
+            &robot,
+            &lattice,
+            (0.25, &LIMITS, &StepBound::zero()),
+            (goal.i, goal.j),
+        );
         // Reference: breadth-first over (cell, orientation) pairs of the defining test.
         let ok = admissible_by_definition(&maps, &robot, &lattice);
         let g = goal.j as usize * nx + goal.i as usize;
@@ -688,7 +708,8 @@ mod tests {
     #[test]
     fn the_cell_shift_scan_matches_the_tests_definition() {
         let (maps, robot, lattice) = odd_terrain();
-        let scan = admissible(&maps, &robot, &lattice, 0.25, &LIMITS).unwrap();
+        let scan =
+            admissible(&maps, &robot, &lattice, 0.25, (&LIMITS, &StepBound::zero())).unwrap();
         let reference = admissible_by_definition(&maps, &robot, &lattice);
         let no = usize::from(lattice.orientations);
         let differing =

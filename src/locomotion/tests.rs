@@ -286,6 +286,32 @@ mod hybrid {
         HybridConfig::new(&Params::default(), &robot(), Neighbourhood::N16)
     }
 
+    #[test]
+    fn a_doorway_in_a_wall_whose_top_no_foot_reaches_is_closed_at_once() {
+        // `impossible_005111` (generated), square to the map: a 0.31 m doorway in a wall
+        // 0.98 m high and 0.29 m thick. The middle of its top lies more than r_F from its
+        // edges, so a foot's cost there is finite, and the reachable regions counted it
+        // as ground a foot might stand on: every pose near the wall could then stand
+        // 0.98 m up, and the regions let the base over it (the search took 958 k
+        // expansions, 15 s, to prove no path). No foot climbs 0.98 m, so the step bound
+        // is infinite there, and such ground now does not count.
+        let w = (4.0 - 0.31) / 2.0;
+        let wall = |y: f64| Primitive::Box {
+            center: [2.0, y],
+            size: [0.29, w],
+            height: 0.98,
+            yaw_deg: 0.0,
+        };
+        let prims = [wall(0.31 / 2.0 + w / 2.0), wall(-0.31 / 2.0 - w / 2.0)];
+        let m = rasterise(&prims, [-1.0, -2.0], [6.0, 4.0], 0.025).expect("map");
+        let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
+        let (i, j) = maps.heights().cell_of(2.0, 1.0).expect("on the map");
+        assert!(maps.foot_cost_cell(i, j).finite().is_some(), "the wall's top is standable");
+        let g = graph(&maps, state_on(&maps, 4.0, 0.0, 0.0));
+        assert!(g.heuristic_parts(state_at(&g, 0.0, 0.0)).reachable.is_infinite());
+        assert!(!g.heuristic_parts(state_at(&g, 3.5, 0.5)).reachable.is_infinite());
+    }
+
     /// Runs one of the generator's own checks (`check`) as the planner does: the CoM
     /// estimate, the planner's margins (`options`).
     fn with_generator<T>(
