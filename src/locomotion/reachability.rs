@@ -488,23 +488,32 @@ mod tests {
         assert!(goal_reachable(&r, &l, [3.3, 0.2]));
     }
 
+    /// A wall `thickness` thick and `height` high across the 4 m map at x = 2 m, with a
+    /// doorway `gap` wide about y = 0.
+    fn doorway(gap: f64, thickness: f64, height: f64) -> [Primitive; 2] {
+        let w = (4.0 - gap) / 2.0;
+        let side = |y: f64| Primitive::Box {
+            center: [2.0, y],
+            size: [thickness, w],
+            height,
+            yaw_deg: 0.0,
+        };
+        [side(gap / 2.0 + w / 2.0), side(-gap / 2.0 - w / 2.0)]
+    }
+
+    /// Whether the relaxation (on) cuts (0, 0) off a goal at (4, 0) beyond [`doorway`].
+    fn doorway_closed(gap: f64, thickness: f64, height: f64) -> bool {
+        let (r, l) = regions(&doorway(gap, thickness, height), [4.0, 0.0]);
+        assert!(r.is_on());
+        !goal_reachable(&r, &l, [0.0, 0.0])
+    }
+
     #[test]
     fn a_doorway_narrower_than_the_robot_is_closed_and_a_wide_one_open() {
-        let door = |gap: f64| {
-            let w = (4.0 - gap) / 2.0;
-            [
-                wall([2.0, gap / 2.0 + w / 2.0], [0.2, w]),
-                wall([2.0, -gap / 2.0 - w / 2.0], [0.2, w]),
-            ]
-        };
         // Narrower than the base's circles (0.4 m across the disc the test uses): closed.
-        // (Between that and the legs' width the relaxation lets a hip hop the wall by
-        // turning; the search proves those.)
-        let (r, l) = regions(&door(0.38), [4.0, 0.0]);
-        assert!(r.is_on());
-        assert!(!goal_reachable(&r, &l, [0.0, 0.0]), "0.38 m door");
-        let (r, l) = regions(&door(1.1), [4.0, 0.0]);
-        assert!(goal_reachable(&r, &l, [0.0, 0.0]), "1.1 m door");
+        // (Wider ones in walls above the hips close too: see the next tests.)
+        assert!(doorway_closed(0.38, 0.2, 1.2), "0.38 m door");
+        assert!(!doorway_closed(1.1, 0.2, 1.2), "1.1 m door");
     }
 
     #[test]
@@ -529,28 +538,10 @@ mod tests {
         // pitch (0.85 m) let the hips pass one by one through the gap while the base
         // crabbed across it, and the search took 1.1 M expansions to prove it. At 0.35 m
         // the thighs pass over the wall: open.
-        let door = |height: f64| {
-            let (gap, w) = (0.42, (4.0 - 0.42) / 2.0);
-            [
-                Primitive::Box {
-                    center: [2.0, gap / 2.0 + w / 2.0],
-                    size: [0.11, w],
-                    height,
-                    yaw_deg: 0.0,
-                },
-                Primitive::Box {
-                    center: [2.0, -gap / 2.0 - w / 2.0],
-                    size: [0.11, w],
-                    height,
-                    yaw_deg: 0.0,
-                },
-            ]
-        };
-        let (r, l) = regions(&door(0.67), [4.0, 0.0]);
-        assert!(r.is_on());
-        assert!(!goal_reachable(&r, &l, [0.0, 0.0]), "0.67 m wall");
-        let (r, l) = regions(&door(0.35), [4.0, 0.0]);
-        assert!(goal_reachable(&r, &l, [0.0, 0.0]), "0.35 m wall");
+        assert!(doorway_closed(0.42, 0.11, 0.67), "0.67 m wall");
+        assert!(!doorway_closed(0.42, 0.11, 0.35), "0.35 m wall");
+        // A wider one in a taller wall too (0.6 m stays open in the relaxation).
+        assert!(doorway_closed(0.5, 0.2, 1.2), "0.5 m door");
     }
 
     #[test]
