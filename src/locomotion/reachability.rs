@@ -39,10 +39,11 @@
 //! and `dx` at least [`StanceLimits::min_feet_spread_m`] over the planner's foot offsets;
 //! `h` at most the standing rule's soft constraint (0.45 m; driving stands at 0.27 m).
 //! On level ground (`H_lo = H_hi`) the pitch is zero and a hip stands at most 0.45 m up:
-//! a wall of 0.65 m closes a doorway narrower than the hips' 0.64 m track, which a fixed
-//! allowance for a pitch of 0.4 rad (0.72 m, 0.85 m with 0.13 m to spare, as this test
-//! had it) left open, and the search took 1.1 M expansions (18 s) to prove it. The
-//! bounds leave the 4 cm leg and 2 cm body clearances as spare.
+//! a wall of 0.65 m closes a 0.42 m doorway (the hips' track is 0.64 m; a 0.6 m doorway
+//! in a 1.2 m wall stays open here), which a fixed allowance for a pitch of 0.4 rad
+//! (0.72 m, 0.85 m with 0.13 m to spare, as this test had it) left open, and the search
+//! took 1.1 M expansions (18 s) to prove it. The bounds leave the 4 cm leg and 2 cm body
+//! clearances as spare.
 //!
 //! **Regions.** The test is made per cell *and orientation*. Admissible (cell,
 //! orientation) pairs at most [`LINK_CELLS`] apart along each axis in the same
