@@ -122,23 +122,53 @@ impl StanceLimits {
         (self.pitch_fraction.abs() * slope).min(FRAC_PI_2)
     }
 
-    /// The rises over `H_hi` for feet on ground at most `span` apart in height.
-    fn rises(&self, robot: &RobotDescription, circles_x: [f64; 2], span: f64) -> Rises {
-        let p = self.max_pitch(span);
-        let (sin, cos) = (p.sin(), p.cos());
+    /// The rise bounds of `robot` with base circles at `circles_x` (x' in the base frame).
+    fn rise_model(&self, robot: &RobotDescription, circles_x: [f64; 2]) -> RiseModel {
         let xs = robot.hips.map(|h| h[0]);
         let (lo, hi) =
             xs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
         let far = xs.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         let c = circles_x.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-        let b = robot.base_bottom_z;
         // Zero for a model whose hip axes share one height (Momaro's do).
         let zs = robot.hips.map(|h| h[2]);
         let tilt = zs.iter().copied().fold(f64::NEG_INFINITY, f64::max)
             - zs.iter().copied().fold(f64::INFINITY, f64::min);
+        RiseModel {
+            limits: *self,
+            hip_spread: hi - lo,
+            body_reach: far + c,
+            tilt,
+            bottom: robot.base_bottom_z,
+            thigh_quarter: robot.thigh_length / 4.0,
+        }
+    }
+}
+
+/// [`StanceLimits`] with the robot's geometry the rises need, taken once per map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct RiseModel {
+    limits: StanceLimits,
+    /// Spread of the hips along x' (max − min), m.
+    hip_spread: f64,
+    /// The farthest hip's |x'| plus the farthest base circle's |x'|, m.
+    body_reach: f64,
+    /// Spread of the hip axes' heights in the base frame, m.
+    tilt: f64,
+    /// The base's underside above the hip axes (`RobotDescription::base_bottom_z`), m.
+    bottom: f64,
+    /// A quarter thigh: how far the thigh's first checked point lies from the hip, m.
+    thigh_quarter: f64,
+}
+
+impl RiseModel {
+    /// The rises over `H_hi` for feet on ground at most `span` apart in height.
+    fn rises(&self, span: f64) -> Rises {
+        let p = self.limits.max_pitch(span);
+        let (sin, cos) = (p.sin(), p.cos());
+        let (h, b) = (self.limits.leg_height_m, self.bottom);
         Rises {
-            hip: self.leg_height_m + sin * (hi - lo) + tilt + robot.thigh_length / 4.0,
-            body: self.leg_height_m + sin * (far + c) + tilt + b.max(b * cos),
+            hip: h + sin * self.hip_spread + self.tilt + self.thigh_quarter,
+            body: h + sin * self.body_reach + self.tilt + b.max(b * cos),
         }
     }
 }
@@ -381,7 +411,7 @@ fn admissible(
     let res = hm.resolution();
     let (low, high) = standable_range_near(maps, steps)?;
     let (low, high) = (low.as_slice(), high.as_slice());
-    let circles_x = robot.base_circle_centres_x(circle_radius_m);
+    let rise_model = limits.rise_model(robot, robot.base_circle_centres_x(circle_radius_m));
     let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
     let legs = maps.leg_terrain();
     let no = usize::from(lattice.orientations);
@@ -402,7 +432,7 @@ fn admissible(
             if !top.is_finite() {
                 continue;
             }
-            let rise = limits.rises(robot, circles_x, top - low[k]);
+            let rise = rise_model.rises(top - low[k]);
             for (o, probe) in probes.iter().enumerate() {
                 let body_ok = probe.body.iter().all(|&d| {
                     shifted(i, j, d)
@@ -429,7 +459,7 @@ fn admissible(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::params::Params;
     use crate::scenario::Primitive;
@@ -491,7 +521,7 @@ mod tests {
 
     /// A wall `thickness` thick and `height` high across the 4 m map at x = 2 m, with a
     /// doorway `gap` wide about y = 0.
-    fn doorway(gap: f64, thickness: f64, height: f64) -> [Primitive; 2] {
+    pub(crate) fn doorway(gap: f64, thickness: f64, height: f64) -> [Primitive; 2] {
         let w = (4.0 - gap) / 2.0;
         let side = |y: f64| Primitive::Box {
             center: [2.0, y],
@@ -551,13 +581,14 @@ mod tests {
         let circles = robot.base_circle_centres_x(0.25);
         // Level ground: no pitch; the leg height, plus a quarter thigh for the hip's
         // first point (0.45 + 0.25 / 4), and the underside at the hip axes.
-        let level = LIMITS.rises(&robot, circles, 0.0);
+        let model = LIMITS.rise_model(&robot, circles);
+        let level = model.rises(0.0);
         assert!((level.hip - 0.5125).abs() < 1e-12, "{level:?}");
         assert!((level.body - 0.45).abs() < 1e-12, "{level:?}");
         // 0.2 m of height within reach, feet 0.3 m apart: p = 0.7 · atan(0.2 / 0.3) =
         // 0.411602 rad, sin p = 0.400078; hips 0.7 m apart along x', the farthest 0.35 m
         // out and the circles 0.2 m: 0.45 + 0.7 sin p + 0.0625 and 0.45 + 0.55 sin p.
-        let steep = LIMITS.rises(&robot, circles, 0.2);
+        let steep = model.rises(0.2);
         assert!((steep.hip - 0.792_554_5).abs() < 1e-6, "{steep:?}");
         assert!((steep.body - 0.670_042_8).abs() < 1e-6, "{steep:?}");
         // Feet that could stand level with each other: the pitch is only bounded by 70 %
@@ -580,6 +611,7 @@ mod tests {
         let (low, high) = standable_range_near(maps, &StepBound::zero()).unwrap();
         let body = DiscMaxLayer::compute(hm, BODY_DISC_M);
         let legs = maps.leg_terrain();
+        let model = LIMITS.rise_model(robot, robot.base_circle_centres_x(0.25));
         let no = usize::from(lattice.orientations);
         let mut out = vec![false; nx * ny * no];
         for (n, out) in out.iter_mut().enumerate() {
@@ -588,8 +620,7 @@ mod tests {
             if !top.is_finite() {
                 continue;
             }
-            let rise =
-                LIMITS.rises(robot, robot.base_circle_centres_x(0.25), top - low.as_slice()[k]);
+            let rise = model.rises(top - low.as_slice()[k]);
             let [x, y] = hm.cell_center(k % nx, k / nx);
             let (s, c) = lattice.yaw(o as u8).sin_cos();
             let body_ok = robot.base_circle_centres_x(0.25).iter().all(|&cx| {

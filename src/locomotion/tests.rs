@@ -295,14 +295,7 @@ mod hybrid {
         // 0.98 m up, and the regions let the base over it (the search took 958 k
         // expansions, 15 s, to prove no path). No foot climbs 0.98 m, so the step bound
         // is infinite there, and such ground now does not count.
-        let w = (4.0 - 0.31) / 2.0;
-        let wall = |y: f64| Primitive::Box {
-            center: [2.0, y],
-            size: [0.29, w],
-            height: 0.98,
-            yaw_deg: 0.0,
-        };
-        let prims = [wall(0.31 / 2.0 + w / 2.0), wall(-0.31 / 2.0 - w / 2.0)];
+        let prims = crate::locomotion::reachability::tests::doorway(0.31, 0.29, 0.98);
         let m = rasterise(&prims, [-1.0, -2.0], [6.0, 4.0], 0.025).expect("map");
         let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
         let (i, j) = maps.heights().cell_of(2.0, 1.0).expect("on the map");
