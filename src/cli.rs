@@ -308,6 +308,25 @@ pub enum BenchCommand {
         #[command(flatten)]
         model: ModelArgs,
     },
+    /// Cold first-path time of `plan` (the guided probe, `--schedule-expansions 0`) over a
+    /// suite of scenarios, one run at a time: per file the median of the repeats, then
+    /// the suite's median, mean and largest.
+    Probe {
+        /// Scenario files or directories (every *.toml below them, recursively); sorted
+        /// and de-duplicated. Default: every scenarios/*.toml of the repository.
+        paths: Vec<PathBuf>,
+        /// Planning time limit of each run, s.
+        #[arg(long, default_value_t = 10.0)]
+        time_limit: f64,
+        /// Runs of each file; its time is their median.
+        #[arg(long, default_value_t = 1)]
+        repeats: usize,
+        /// Print the result as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
     /// Real-time factor of `momaro sim` against a bare mj_step loop on the same world.
     Sim {
         /// Scenario file.
@@ -1057,6 +1076,51 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                         ms(Some(r.heuristic_setup_s))
                     );
                 }
+            }
+            Ok(true)
+        }
+        Command::Bench(BenchCommand::Probe { paths, time_limit, repeats, json, model }) => {
+            let files = if paths.is_empty() {
+                let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+                jobs::check::repository_scenarios(&dir)
+            } else {
+                jobs::check::discover(&paths)
+            }
+            .map_err(check_error)?;
+            let scenarios = files.iter().map(|f| load(f)).collect::<anyhow::Result<Vec<_>>>()?;
+            let opts = jobs::bench::ProbeBenchOptions { time_limit_s: time_limit, repeats };
+            let b = jobs::bench::probe_bench(&scenarios, &robot(&model.model)?, &opts)
+                .map_err(plan_error)?;
+            if json {
+                print_json(&b)?;
+            } else {
+                say!(
+                    "{:<28} {:<10} {:>10} {:>11} {:>12}",
+                    "scenario",
+                    "outcome",
+                    "time ms",
+                    "expansions",
+                    "cost"
+                );
+                for r in &b.rows {
+                    say!(
+                        "{:<28} {:<10} {:>10.1} {:>11} {:>12}",
+                        r.scenario,
+                        r.outcome,
+                        r.time_s * 1e3,
+                        r.expansions.map_or("-".to_owned(), |e| e.to_string()),
+                        r.cost.map_or("-".to_owned(), |c| format!("{c:.3}"))
+                    );
+                }
+                say!(
+                    "{} files, {} with a path (median of {} runs each): median {:.1} ms, mean {:.1} ms, largest {:.1} ms",
+                    b.rows.len(),
+                    b.paths,
+                    b.repeats,
+                    b.median_s * 1e3,
+                    b.mean_s * 1e3,
+                    b.max_s * 1e3
+                );
             }
             Ok(true)
         }

@@ -137,6 +137,42 @@ fn bad_drive_option() {
 }
 
 #[test]
+fn bench_probe_times_each_file_and_the_suite() {
+    // A drive and a closed room: one path, one "no path" (refused at once), each a row;
+    // the suite's median of two rows is the upper one, the larger time.
+    let flat = common::root().join("scenarios/flat.toml");
+    let closed = common::root().join("scenarios/closed_room.toml");
+    let out = momaro(&[
+        "bench",
+        "probe",
+        flat.to_str().unwrap(),
+        closed.to_str().unwrap(),
+        "--repeats",
+        "2",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let rows = v["rows"].as_array().expect("rows");
+    let row = |name: &str| rows.iter().find(|r| r["scenario"] == name).expect(name).clone();
+    let (flat_row, closed_row) = (row("flat"), row("closed_room"));
+    assert_eq!(flat_row["outcome"], "path");
+    assert!(flat_row["expansions"].as_u64().is_some_and(|e| e > 0), "{flat_row}");
+    assert!(flat_row["cost"].as_f64().is_some_and(|c| c > 0.0), "{flat_row}");
+    assert_eq!(closed_row["outcome"], "no_path");
+    assert!(closed_row["cost"].is_null());
+    assert_eq!(v["paths"], 1);
+    assert_eq!(v["repeats"], 2);
+    let times: Vec<f64> = rows.iter().map(|r| r["time_s"].as_f64().unwrap()).collect();
+    assert_eq!(v["median_s"].as_f64().unwrap(), times[0].max(times[1]));
+    assert!((v["mean_s"].as_f64().unwrap() - (times[0] + times[1]) / 2.0).abs() < 1e-12);
+    let out = momaro(&["bench", "probe", flat.to_str().unwrap(), "--repeats", "0"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("repeats") && !stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
 fn bad_planner_option_names_the_parameter() {
     let scenario = common::root().join("scenarios/flat.toml");
     for bad in ["nan", "-1"] {

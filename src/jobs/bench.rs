@@ -3,15 +3,24 @@
 //! The medians here (`median`, `median_option`) also serve `bench plan`
 //! (`jobs::plan::bench`), whose times are medians over its repeats.
 //!
+//! `bench probe` times the planner's first path as `plan` finds it (the guided greedy
+//! probe, cold: maps and heuristic tables built for the file) over a suite of scenario
+//! files, one at a time: per file the median of the repeats, then the suite's median,
+//! mean and largest. Issue 15's targets for generated courses are such medians.
+//!
 //! `bench sim` runs a scenario's world twice for the same simulated time: once as a bare
 //! `mj_step` loop with the actuator targets of the standing posture fixed (the physics
 //! limit), once as `momaro sim` runs it (controller and stability monitor every control
 //! tick). The ratio of the two real-time factors is the cost of our own code per step.
 
+use super::plan::{self, PlanJobError, PlanOptions};
 use super::sim::{SimJobError, SimOptions};
+use crate::planner::Termination;
+use crate::robot::RobotDescription;
 use crate::scenario::Scenario;
 use crate::sim::Simulation;
 use serde::Serialize;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Result of `bench sim`.
@@ -93,5 +102,112 @@ pub fn sim_bench(
         controlled_step_us: per_step(ctrl_rtf),
         overhead_fraction: bare_rtf / ctrl_rtf - 1.0,
         repeats,
+    })
+}
+
+/// Options of `bench probe`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProbeBenchOptions {
+    /// Planning time limit of each run, s (`plan --time-limit`).
+    pub time_limit_s: f64,
+    /// Runs of each file; its time is their median.
+    pub repeats: usize,
+}
+
+/// One file of `bench probe`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProbeRow {
+    /// Scenario name.
+    pub scenario: String,
+    /// The file.
+    pub path: PathBuf,
+    /// `path` (a path found), `no_path` (every reachable pose searched) or `time_limit`.
+    pub outcome: &'static str,
+    /// Median over the repeats of the wall time of the plan, maps and heuristic set-up
+    /// included (what `plan` reports as its planning time), s.
+    pub time_s: f64,
+    /// States the search expanded (of the last repeat; the search is deterministic), when
+    /// it found a path.
+    pub expansions: Option<u64>,
+    /// The path's cost, when one was found.
+    pub cost: Option<f64>,
+}
+
+/// Result of `bench probe`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProbeBench {
+    /// One row per file, in the order given.
+    pub rows: Vec<ProbeRow>,
+    /// Runs of each file.
+    pub repeats: usize,
+    /// Files whose plan found a path.
+    pub paths: usize,
+    /// Median of the rows' times (the upper one of an even count), s.
+    pub median_s: f64,
+    /// Mean of the rows' times, s.
+    pub mean_s: f64,
+    /// Largest of the rows' times, s.
+    pub max_s: f64,
+}
+
+/// Times `plan`'s first path (the probe's, `--schedule-expansions 0`) on each of
+/// `scenarios`, `opts.repeats` times each, one run at a time. A file with no path (or
+/// none within the limit) is a row with its time, not an error.
+///
+/// # Errors
+/// `opts` out of range, or a plan that fails for another reason than finding no path
+/// (a start off the map, a bad parameter, ...).
+pub fn probe_bench(
+    scenarios: &[Scenario],
+    robot: &RobotDescription,
+    opts: &ProbeBenchOptions,
+) -> Result<ProbeBench, PlanJobError> {
+    if opts.repeats == 0 {
+        return Err(PlanJobError::BadOption {
+            option: "repeats",
+            reason: "0 must be at least 1".into(),
+        });
+    }
+    let plan_opts = PlanOptions {
+        time_limit_s: opts.time_limit_s,
+        schedule_expansions: Some(0),
+        ..PlanOptions::default()
+    };
+    let mut rows = Vec::with_capacity(scenarios.len());
+    for sc in scenarios {
+        let mut times = Vec::with_capacity(opts.repeats);
+        let (mut outcome, mut expansions, mut cost) = ("path", None, None);
+        for _ in 0..opts.repeats {
+            let t = Instant::now();
+            let result = plan::run(sc, robot, &plan_opts);
+            times.push(t.elapsed().as_secs_f64());
+            (outcome, expansions, cost) = match result {
+                Ok(s) => ("path", Some(s.expansions), Some(s.cost)),
+                Err(PlanJobError::NoPath { termination: Termination::NoPath, .. }) => {
+                    ("no_path", None, None)
+                }
+                Err(PlanJobError::NoPath { .. }) => ("time_limit", None, None),
+                Err(e) => return Err(e),
+            };
+        }
+        rows.push(ProbeRow {
+            scenario: sc.name.clone(),
+            path: sc.path.clone(),
+            outcome,
+            time_s: median(times),
+            expansions,
+            cost,
+        });
+    }
+    let times: Vec<f64> = rows.iter().map(|r| r.time_s).collect();
+    let mean_s = times.iter().sum::<f64>() / times.len().max(1) as f64;
+    let max_s = times.iter().copied().fold(0.0, f64::max);
+    Ok(ProbeBench {
+        paths: rows.iter().filter(|r| r.outcome == "path").count(),
+        median_s: median(times),
+        mean_s,
+        max_s,
+        repeats: opts.repeats,
+        rows,
     })
 }
