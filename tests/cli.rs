@@ -160,7 +160,11 @@ fn bench_probe_times_each_file_and_the_suite() {
     assert!(flat_row["expansions"].as_u64().is_some_and(|e| e > 0), "{flat_row}");
     assert!(flat_row["cost"].as_f64().is_some_and(|c| c > 0.0), "{flat_row}");
     assert_eq!(closed_row["outcome"], "no_path");
-    assert!(closed_row["cost"].is_null());
+    assert!(closed_row["cost"].is_null() && closed_row["search_s"].is_null());
+    // The search alone is part of the whole plan's wall time; one row has a search time.
+    let search = flat_row["search_s"].as_f64().expect("search time");
+    assert!(search > 0.0 && search <= flat_row["time_s"].as_f64().unwrap(), "{flat_row}");
+    assert_eq!(v["median_search_s"].as_f64(), Some(search));
     assert_eq!(v["paths"], 1);
     assert_eq!(v["repeats"], 2);
     let times: Vec<f64> = rows.iter().map(|r| r["time_s"].as_f64().unwrap()).collect();

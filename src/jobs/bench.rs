@@ -123,9 +123,13 @@ pub struct ProbeRow {
     pub path: PathBuf,
     /// `path` (a path found), `no_path` (every reachable pose searched) or `time_limit`.
     pub outcome: &'static str,
-    /// Median over the repeats of the wall time of the plan, maps and heuristic set-up
-    /// included (what `plan` reports as its planning time), s.
+    /// Median over the repeats of the wall time of the whole plan: maps, the heuristic's
+    /// set-up and the search (what a user of `plan` waits for), s.
     pub time_s: f64,
+    /// Median over the repeats of the search's own time (`plan`'s `planning_time_s`: the
+    /// lazy cost-to-go included, the maps and the heuristic's set-up not), when it
+    /// found a path, s.
+    pub search_s: Option<f64>,
     /// States the search expanded (of the last repeat; the search is deterministic), when
     /// it found a path.
     pub expansions: Option<u64>,
@@ -148,6 +152,8 @@ pub struct ProbeBench {
     pub mean_s: f64,
     /// Largest of the rows' times, s.
     pub max_s: f64,
+    /// Median of the rows' search times, over the rows with a path, s (`None` if none).
+    pub median_search_s: Option<f64>,
 }
 
 /// Times `plan`'s first path (the probe's, `--schedule-expansions 0`) on each of
@@ -175,12 +181,15 @@ pub fn probe_bench(
     };
     let mut rows = Vec::with_capacity(scenarios.len());
     for sc in scenarios {
-        let mut times = Vec::with_capacity(opts.repeats);
+        let (mut times, mut searches) = (Vec::new(), Vec::new());
         let (mut outcome, mut expansions, mut cost) = ("path", None, None);
         for _ in 0..opts.repeats {
             let t = Instant::now();
             let result = plan::run(sc, robot, &plan_opts);
             times.push(t.elapsed().as_secs_f64());
+            if let Ok(s) = &result {
+                searches.push(s.planning_time_s);
+            }
             (outcome, expansions, cost) = match result {
                 Ok(s) => ("path", Some(s.expansions), Some(s.cost)),
                 Err(PlanJobError::NoPath { termination: Termination::NoPath, .. }) => {
@@ -195,6 +204,7 @@ pub fn probe_bench(
             path: sc.path.clone(),
             outcome,
             time_s: median(times),
+            search_s: (!searches.is_empty()).then(|| median(searches)),
             expansions,
             cost,
         });
@@ -202,7 +212,9 @@ pub fn probe_bench(
     let times: Vec<f64> = rows.iter().map(|r| r.time_s).collect();
     let mean_s = times.iter().sum::<f64>() / times.len().max(1) as f64;
     let max_s = times.iter().copied().fold(0.0, f64::max);
+    let searches: Vec<f64> = rows.iter().filter_map(|r| r.search_s).collect();
     Ok(ProbeBench {
+        median_search_s: (!searches.is_empty()).then(|| median(searches)),
         paths: rows.iter().filter(|r| r.outcome == "path").count(),
         median_s: median(times),
         mean_s,
