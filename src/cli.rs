@@ -285,6 +285,19 @@ impl PlannerArgs {
     }
 }
 
+/// What `bench plan` and `bench probe` share.
+#[derive(Debug, Args)]
+pub struct BenchRunArgs {
+    /// Runs of each search (`bench plan`) or file (`bench probe`); times are their medians.
+    #[arg(long, default_value_t = 1)]
+    repeats: usize,
+    /// Print the result as JSON.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
 /// The benchmarks.
 #[derive(Debug, Subcommand)]
 pub enum BenchCommand {
@@ -299,14 +312,8 @@ pub enum BenchCommand {
         /// Time budget of the A* run that finds the optimum, s.
         #[arg(long, default_value_t = 120.0)]
         optimum_limit: f64,
-        /// Runs of each search; times are their medians.
-        #[arg(long, default_value_t = 1)]
-        repeats: usize,
-        /// Print the result as JSON.
-        #[arg(long)]
-        json: bool,
         #[command(flatten)]
-        model: ModelArgs,
+        run: BenchRunArgs,
     },
     /// Cold first-path time of `plan` (the guided probe, `--schedule-expansions 0`) over a
     /// suite of scenarios, one run at a time: per file the median of the repeats, then
@@ -318,14 +325,8 @@ pub enum BenchCommand {
         /// Planning time limit of each run, s.
         #[arg(long, default_value_t = 10.0)]
         time_limit: f64,
-        /// Runs of each file; its time is their median.
-        #[arg(long, default_value_t = 1)]
-        repeats: usize,
-        /// Print the result as JSON.
-        #[arg(long)]
-        json: bool,
         #[command(flatten)]
-        model: ModelArgs,
+        run: BenchRunArgs,
     },
     /// Real-time factor of `momaro sim` against a bare mj_step loop on the same world.
     Sim {
@@ -1018,9 +1019,7 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             scenario,
             arastar_limit,
             optimum_limit,
-            repeats,
-            json,
-            model,
+            run: BenchRunArgs { repeats, json, model },
         }) => {
             let sc = load(&scenario)?;
             let opts = jobs::plan::BenchOptions {
@@ -1079,7 +1078,11 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             }
             Ok(true)
         }
-        Command::Bench(BenchCommand::Probe { paths, time_limit, repeats, json, model }) => {
+        Command::Bench(BenchCommand::Probe {
+            paths,
+            time_limit,
+            run: BenchRunArgs { repeats, json, model },
+        }) => {
             let files = if paths.is_empty() {
                 let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
                 jobs::check::repository_scenarios(&dir)
