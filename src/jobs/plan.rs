@@ -30,13 +30,13 @@ use crate::locomotion::{
     Algorithm, DrivingGoal, HeuristicCache, HybridConfig, HybridGraph, Lattice, LatticeError,
     LatticeState, ManoeuvreKind, ManoeuvreStats, Neighbourhood, PoseKey, StepCost,
 };
-use crate::params::{FootModel, InvalidParam, Params};
+use crate::params::{FootModel, InvalidParam, Params, StepModel};
 use crate::planner::{
     Cost, ExpandHook, Expansion, Hooks, SearchError, SearchParams, SearchResult, Termination,
     arastar_with_hooks, astar_with_hooks,
 };
 use crate::robot::{Leg, RobotDescription};
-use crate::scenario::Scenario;
+use crate::scenario::{Primitive, Scenario};
 use crate::terrain::{RasteriseError, rasterise};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -779,6 +779,33 @@ fn check_options(opts: &PlanOptions) -> Result<Duration, PlanJobError> {
 
 /// The search of [`run`] and [`run_on`] on `prep`, its time limit `limit` counted from
 /// `t0`.
+/// Flights of this many steps or more have no path with the paper's step model (README,
+/// "Step model": the feet of one side stay a hip spacing apart, longer than such a
+/// flight's treads allow).
+const PAPER_MODEL_FLIGHT_STEPS: u32 = 4;
+
+/// What a "no path" adds for a scenario planned with the paper's step model whose
+/// terrain has a flight of [`PAPER_MODEL_FLIGHT_STEPS`] or more: the models that climb
+/// it. Empty otherwise.
+fn stairs_model_hint(scenario: &Scenario, step_model: StepModel) -> String {
+    let longest = scenario
+        .terrain
+        .iter()
+        .filter_map(|p| match p {
+            Primitive::Stairs { steps, .. } => Some(*steps),
+            _ => None,
+        })
+        .max();
+    match longest {
+        Some(n) if step_model == StepModel::Paper && n >= PAPER_MODEL_FLIGHT_STEPS => format!(
+            "; its stairs have {n} steps, and with step_model = \"paper\" flights of \
+             {PAPER_MODEL_FLIGHT_STEPS} or more have no path: set step_model = \"stairs\" \
+             and foot_model = \"wheel_pair\" in its [params] (README, \"Step model\")"
+        ),
+        _ => String::new(),
+    }
+}
+
 fn search_prepared(
     prep: &Prepared,
     scenario: &Scenario,
@@ -838,6 +865,7 @@ fn search_prepared(
             ),
             t => format!("the search stopped ({})", termination_name(t)),
         };
+        let reason = reason + &stairs_model_hint(scenario, prep.params.step_model);
         return Err(PlanJobError::NoPath {
             scenario: file(),
             termination: result.termination,
@@ -1240,6 +1268,31 @@ mod tests {
             "; of 20 step checks 10 failed: 4 with no leg height within reach, 3 front and \
              2 rear steps with no stable motion, 1 otherwise"
         );
+    }
+
+    #[test]
+    fn a_long_flight_planned_with_the_paper_step_model_is_told_the_stairs_models() {
+        // The repository's six-step flight names the stairs models; without them (or with
+        // the paper's) a "no path" says which to set, and so does a four-step flight; a
+        // three-step one (which the paper's model climbs) and the stairs model get none.
+        use crate::params::StepModel;
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/stairs_long.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let sc = crate::scenario::Scenario::parse(&text, &path).unwrap();
+        assert_eq!(super::stairs_model_hint(&sc, StepModel::Stairs), "");
+        let hint = super::stairs_model_hint(&sc, StepModel::Paper);
+        assert!(
+            hint.starts_with("; its stairs have 6 steps")
+                && hint.contains("step_model = \"stairs\"")
+                && hint.contains("foot_model = \"wheel_pair\""),
+            "{hint}"
+        );
+        for (steps, hinted) in [(4, true), (3, false)] {
+            let t = text.replace("steps = 6", &format!("steps = {steps}"));
+            let sc = crate::scenario::Scenario::parse(&t, &path).unwrap();
+            assert_eq!(!super::stairs_model_hint(&sc, StepModel::Paper).is_empty(), hinted);
+        }
     }
 
     fn run(first: f64, to_optimum: Option<f64>, at_1s: Option<f64>, rate: f64) -> BenchRow {
