@@ -121,7 +121,8 @@ pub struct ProbeRow {
     pub scenario: String,
     /// The file.
     pub path: PathBuf,
-    /// `path` (a path found), `no_path` (every reachable pose searched) or `time_limit`.
+    /// `path` (a path found), `no_path` (every reachable pose searched) or `time_limit`,
+    /// of the last repeat (repeats differ only where the time limit falls between them).
     pub outcome: &'static str,
     /// Median over the repeats of the wall time of the whole plan: maps, the heuristic's
     /// set-up and the search (what a user of `plan` waits for), s.
