@@ -1092,8 +1092,23 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             .map_err(check_error)?;
             let scenarios = files.iter().map(|f| load(f)).collect::<anyhow::Result<Vec<_>>>()?;
             let opts = jobs::bench::ProbeBenchOptions { time_limit_s: time_limit, repeats };
-            let b = jobs::bench::probe_bench(&scenarios, &robot(&model.model)?, &opts)
-                .map_err(plan_error)?;
+            let (total, width) = (scenarios.len(), scenarios.len().to_string().len());
+            let b = jobs::bench::probe_bench(
+                &scenarios,
+                &robot(&model.model)?,
+                &opts,
+                &mut |done, r| {
+                    use std::io::Write as _;
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "[{done:>width$}/{total}] {:<24} {:<10} {:>8.1} ms",
+                        r.scenario,
+                        r.outcome,
+                        r.time_s * 1e3
+                    );
+                },
+            )
+            .map_err(plan_error)?;
             if json {
                 print_json(&b)?;
             } else {

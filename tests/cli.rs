@@ -151,7 +151,13 @@ fn bench_probe_times_each_file_and_the_suite() {
         "2",
         "--json",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    // A progress line per file as it is done, sorted like `check`'s suite.
+    let progress: Vec<&str> = stderr.lines().filter(|l| l.starts_with('[')).collect();
+    assert_eq!(progress.len(), 2, "{stderr}");
+    assert!(progress[0].starts_with("[1/2] closed_room") && progress[0].contains("no_path"));
+    assert!(progress[1].starts_with("[2/2] flat") && progress[1].contains("path"));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     let rows = v["rows"].as_array().expect("rows");
     let row = |name: &str| rows.iter().find(|r| r["scenario"] == name).expect(name).clone();

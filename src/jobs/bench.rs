@@ -159,7 +159,8 @@ pub struct ProbeBench {
 
 /// Times `plan`'s first path (the probe's, `--schedule-expansions 0`) on each of
 /// `scenarios`, `opts.repeats` times each, one run at a time. A file with no path (or
-/// none within the limit) is a row with its time, not an error.
+/// none within the limit) is a row with its time, not an error. `on_row` hears of each
+/// row as it is done, with how many are (progress on long suites).
 ///
 /// # Errors
 /// `opts` out of range, or a plan that fails for another reason than finding no path
@@ -168,6 +169,7 @@ pub fn probe_bench(
     scenarios: &[Scenario],
     robot: &RobotDescription,
     opts: &ProbeBenchOptions,
+    on_row: &mut dyn FnMut(usize, &ProbeRow),
 ) -> Result<ProbeBench, PlanJobError> {
     if opts.repeats == 0 {
         return Err(PlanJobError::BadOption {
@@ -209,6 +211,9 @@ pub fn probe_bench(
             expansions,
             cost,
         });
+        if let Some(r) = rows.last() {
+            on_row(rows.len(), r);
+        }
     }
     let times: Vec<f64> = rows.iter().map(|r| r.time_s).collect();
     let mean_s = times.iter().sum::<f64>() / times.len().max(1) as f64;
