@@ -521,6 +521,18 @@ fn check_error(e: jobs::check::CheckError) -> anyhow::Error {
 
 /// `momaro check`: the suite's rows on stderr as they finish, then the table (or JSON) in
 /// the suite's order on stdout.
+/// The scenario files of a suite (`check`, `bench probe`): those below `paths`, sorted
+/// and de-duplicated, or every scenarios/*.toml of the repository if none is given.
+fn suite_files(paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+    if paths.is_empty() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+        jobs::check::repository_scenarios(&dir)
+    } else {
+        jobs::check::discover(paths)
+    }
+    .map_err(check_error)
+}
+
 fn check(
     paths: &[PathBuf],
     planner: &PlannerArgs,
@@ -533,13 +545,7 @@ fn check(
     use jobs::check;
     let shard = shard.map(str::parse::<check::Shard>).transpose().map_err(check_error)?;
     let jobs = workers_or_all(jobs);
-    let files = if paths.is_empty() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
-        check::repository_scenarios(&dir)
-    } else {
-        check::discover(paths)
-    }
-    .map_err(check_error)?;
+    let files = suite_files(paths)?;
     let opts = check::CheckOptions {
         run: jobs::run::RunOptions::new(planner.options(), model),
         jobs,
@@ -1083,14 +1089,8 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             time_limit,
             run: BenchRunArgs { repeats, json, model },
         }) => {
-            let files = if paths.is_empty() {
-                let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
-                jobs::check::repository_scenarios(&dir)
-            } else {
-                jobs::check::discover(&paths)
-            }
-            .map_err(check_error)?;
-            let scenarios = files.iter().map(|f| load(f)).collect::<anyhow::Result<Vec<_>>>()?;
+            let scenarios =
+                suite_files(&paths)?.iter().map(|f| load(f)).collect::<anyhow::Result<Vec<_>>>()?;
             let opts = jobs::bench::ProbeBenchOptions { time_limit_s: time_limit, repeats };
             let (total, width) = (scenarios.len(), scenarios.len().to_string().len());
             let b = jobs::bench::probe_bench(

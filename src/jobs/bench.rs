@@ -172,10 +172,7 @@ pub fn probe_bench(
     on_row: &mut dyn FnMut(usize, &ProbeRow),
 ) -> Result<ProbeBench, PlanJobError> {
     if opts.repeats == 0 {
-        return Err(PlanJobError::BadOption {
-            option: "repeats",
-            reason: "0 must be at least 1".into(),
-        });
+        return Err(plan::bad("repeats", "0 must be at least 1"));
     }
     let plan_opts = PlanOptions {
         time_limit_s: opts.time_limit_s,

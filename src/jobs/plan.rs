@@ -392,7 +392,7 @@ pub struct Prepared {
     pub heuristics: HeuristicCache,
 }
 
-fn bad(option: &'static str, reason: impl Into<String>) -> PlanJobError {
+pub(super) fn bad(option: &'static str, reason: impl Into<String>) -> PlanJobError {
     PlanJobError::BadOption { option, reason: reason.into() }
 }
 
@@ -777,8 +777,6 @@ fn check_options(opts: &PlanOptions) -> Result<Duration, PlanJobError> {
     Ok(limit)
 }
 
-/// The search of [`run`] and [`run_on`] on `prep`, its time limit `limit` counted from
-/// `t0`.
 /// Flights of this many steps or more have no path with the paper's step model (README,
 /// "Step model": the feet of one side stay a hip spacing apart, longer than such a
 /// flight's treads allow).
@@ -806,6 +804,8 @@ fn stairs_model_hint(scenario: &Scenario, step_model: StepModel) -> String {
     }
 }
 
+/// The search of [`run`] and [`run_on`] on `prep`, its time limit `limit` counted from
+/// `t0`.
 fn search_prepared(
     prep: &Prepared,
     scenario: &Scenario,
