@@ -25,10 +25,11 @@
 //! contacts MuJoCo reports ([`stance_error`]: each leg whose two wheels touch stands at
 //! their midpoint; the shift and turn that best take the footholds onto them). Where a
 //! foot stands more than [`ExecutorConfig::slide_threshold_m`] (half a cell) from its
-//! foothold, every pair steers to its own way back (the wheel kinematics of the body twist
-//! that turns and shifts the robot back; at most 90° of steering) and rolls, until the
-//! measured base pose has turned and moved by the error (closed loop on the base, pairs
-//! at most [`ExecutorConfig::slide_speed_mps`], given up after
+//! foothold, every pair steers to its own way back and rolls: each roll is made along one
+//! arc (the constant body twist from where it starts to where it ends, so each pair keeps
+//! one steering angle, at most 90° from straight, the one checked on the height map), at a
+//! speed set by how much of the arc the measured base has left (closed loop along the arc,
+//! pairs at most [`ExecutorConfig::slide_speed_mps`], given up after
 //! [`ExecutorConfig::max_slide_s`]); then the pairs steer straight again before the step's
 //! first segment. The legs keep their targets (the holds are frozen), so the relative
 //! geometry of base and feet does not change.
@@ -233,22 +234,61 @@ fn rolled(p: &Posture, roll: &Roll) -> Posture {
     q
 }
 
-/// The twist (robot frame) that moves a robot at pose `at` toward pose `target` on its
-/// wheels: translation and turn each at `SLIDE_GAIN` per unit left, scaled together so
-/// that no pair (`reach`: the farthest pair's distance from the base origin, m) moves
-/// faster than about `max_speed`.
-fn slide_twist(at: Pose2, target: Pose2, reach: f64, max_speed: f64) -> Twist {
-    let remaining = [target.x - at.x, target.y - at.y];
-    let turn = wrap_angle(target.theta - at.theta);
-    let (vx_w, vy_w) = (SLIDE_GAIN * remaining[0], SLIDE_GAIN * remaining[1]);
-    let wz = SLIDE_GAIN * turn;
-    let fastest = vx_w.hypot(vy_w) + wz.abs() * reach;
-    if fastest < 1e-12 {
-        return Twist::default();
+/// The constant twist (robot frame of `from`, per unit time) that carries pose `from` to
+/// pose `to`: the SE(2) logarithm, a circular arc (a straight line where the two poses
+/// have one heading). In the robot's frame every wheel pair moves in one direction along
+/// it, so a roll made along its arc keeps each pair at one steering angle.
+fn arc_twist(from: Pose2, to: Pose2) -> Twist {
+    let turn = wrap_angle(to.theta - from.theta);
+    let d = from.inverse_transform([to.x, to.y]);
+    // d = V · v with V = [[a, −b], [b, a]], a = sin θ / θ, b = (1 − cos θ) / θ.
+    let (a, b) =
+        if turn.abs() < 1e-9 { (1.0, 0.0) } else { (turn.sin() / turn, (1.0 - turn.cos()) / turn) };
+    let n = a * a + b * b;
+    Twist { vx: (a * d[0] + b * d[1]) / n, vy: (-b * d[0] + a * d[1]) / n, wz: turn }
+}
+
+/// The velocity of a wheel pair at `foot` (robot frame, m) under `twist`.
+fn pair_velocity(twist: Twist, foot: [f64; 2]) -> [f64; 2] {
+    [twist.vx - twist.wz * foot[1], twist.vy + twist.wz * foot[0]]
+}
+
+/// The twist that continues a roll along its arc `arc` ([`arc_twist`] from the roll's
+/// start to its end) from pose `at` toward its end pose `target`, the pairs at `feet`
+/// (robot frame): `arc` scaled by `SLIDE_GAIN` times the part of it left (the least-squares
+/// fraction over the pairs' displacements, negative past the end), capped so that no pair
+/// rolls faster than `max_speed`; and the farthest pair's distance left along the arc (m).
+///
+/// The direction stays the arc's: the pairs keep the steering the roll was checked with
+/// on the height map (`StepExecutor::steering_keeps_the_ground`), and a pair rolls back
+/// past the end without steering round. A slide that instead pointed every tick at the
+/// whole error left steered its pairs after the error's direction, which turns as the
+/// robot nears the target; on an 8-step descent (generated, stairs seed 12072) four
+/// loaded pairs swung through 90° within 0.1 s, their steering torques turned the robot
+/// 7° on its wheels, and it fell down the flight. What the arc cannot take out (the
+/// steering's own reaction turning the robot a little) is measured again before the next
+/// step.
+fn along_the_arc(
+    at: Pose2,
+    target: Pose2,
+    arc: Twist,
+    feet: &[[f64; 2]; 4],
+    max_speed: f64,
+) -> (Twist, f64) {
+    let left = arc_twist(at, target);
+    let (mut along, mut norm, mut span) = (0.0, 0.0, 0.0f64);
+    for f in feet {
+        let (u, v) = (pair_velocity(arc, *f), pair_velocity(left, *f));
+        along += u[0] * v[0] + u[1] * v[1];
+        norm += u[0] * u[0] + u[1] * u[1];
+        span = span.max(u[0].hypot(u[1]));
     }
-    let k = (max_speed / fastest).min(1.0);
-    let (s, c) = at.theta.sin_cos();
-    Twist { vx: k * (c * vx_w + s * vy_w), vy: k * (-s * vx_w + c * vy_w), wz: k * wz }
+    if span < 1e-9 {
+        return (Twist::default(), 0.0);
+    }
+    let fraction = along / norm;
+    let k = (SLIDE_GAIN * fraction).clamp(-max_speed / span, max_speed / span);
+    (Twist { vx: k * arc.vx, vy: k * arc.vy, wz: k * arc.wz }, fraction.abs() * span)
 }
 
 impl StepExecutor {
@@ -520,14 +560,12 @@ impl StepExecutor {
         let c: &ExecutorConfig = &self.config;
         let out_of_time = elapsed >= c.max_slide_s;
         let feet = pairs_in_base(&self.robot, &p);
-        let reach = feet.iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
-        // The base pose at the end of roll `k`.
+        let max_speed = c.slide_speed_mps;
+        // The base pose at the end of roll `k`, and the arc it is made along.
         let target = |k: usize| rolls[..=k].iter().fold(start, |b, r| r.apply_pose(b));
-        let done = |k: usize| {
-            let t = target(k);
-            (t.x - obs.base.x).hypot(t.y - obs.base.y) < SLIDE_DONE_M
-                && wrap_angle(t.theta - obs.base.theta).abs() * reach < SLIDE_DONE_M
-        };
+        let arc = |k: usize| arc_twist(if k == 0 { start } else { target(k - 1) }, target(k));
+        let toward = |k: usize| along_the_arc(obs.base, target(k), arc(k), &feet, max_speed);
+        let done = |k: usize| toward(k).1 < SLIDE_DONE_M;
         while rolling && roll + 1 < rolls.len() && done(roll) {
             roll += 1;
         }
@@ -544,7 +582,7 @@ impl StepExecutor {
             }
             return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
         }
-        let twist = slide_twist(obs.base, target(roll), reach, c.slide_speed_mps);
+        let (twist, _) = toward(roll);
         let wheels = c.wheels.commands(&self.robot, twist, &feet, &obs.steering);
         self.mode = Mode::Slide { index, start, rolls, roll, elapsed: elapsed + dt, rolling };
         Command { legs, wheels: self.with_steer_rate(wheels, obs) }
@@ -663,22 +701,79 @@ mod tests {
     }
 
     #[test]
-    fn the_slide_twist_points_at_the_remaining_pose_in_the_robot_frame() {
+    fn the_arc_twist_is_the_constant_body_twist_between_two_poses() {
         use std::f64::consts::FRAC_PI_2;
-        let at = Pose2::new(0.0, 0.0, FRAC_PI_2);
-        // 1 cm left in the world at heading 90°: the robot's −x' (it rolls backward),
-        // at 2/s · 0.01 m = 0.02 m/s; 10 cm left: capped at 0.03 m/s.
-        let t = slide_twist(at, Pose2::new(-0.01, 0.0, FRAC_PI_2), 0.5, 0.03);
-        assert!(t.vx.abs() < 1e-12 && (t.vy - 0.02).abs() < 1e-12 && t.wz == 0.0, "{t:?}");
-        let t = slide_twist(Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.0, 0.1, 0.0), 0.5, 0.03);
-        assert!(t.vx.abs() < 1e-12 && (t.vy - 0.03).abs() < 1e-12, "{t:?}");
-        // A turn of 0.01 rad left: 0.02 rad/s (the farthest pair, 0.5 m out, at 1 cm/s);
-        // of 0.1 rad: the pair would go at 0.1 m/s, so all is scaled to 0.03: 0.06 rad/s.
-        let t = slide_twist(at, Pose2::new(0.0, 0.0, FRAC_PI_2 + 0.01), 0.5, 0.03);
-        assert!(t.vx.abs() < 1e-12 && t.vy.abs() < 1e-12 && (t.wz - 0.02).abs() < 1e-12);
-        let t = slide_twist(at, Pose2::new(0.0, 0.0, FRAC_PI_2 + 0.1), 0.5, 0.03);
-        assert!((t.wz - 0.06).abs() < 1e-12, "{t:?}");
-        assert_eq!(slide_twist(at, at, 0.5, 0.03), Twist::default());
+        let near = |t: Twist, e: [f64; 3]| {
+            (t.vx - e[0]).abs() < 1e-12
+                && (t.vy - e[1]).abs() < 1e-12
+                && (t.wz - e[2]).abs() < 1e-12
+        };
+        // 1 cm along −x in the world at heading 90°: the robot's +y' (its right is −x).
+        let t = arc_twist(Pose2::new(0.0, 0.0, FRAC_PI_2), Pose2::new(-0.01, 0.0, FRAC_PI_2));
+        assert!(near(t, [0.0, 0.01, 0.0]), "{t:?}");
+        // A quarter circle of radius 1 to the left, (0, 0, 0) to (1, 1, 90°): forward at
+        // π/2 per unit time, turning at π/2 (a = b = 2/π, so v = (a + b) / (a² + b²) = π/2).
+        let t = arc_twist(Pose2::new(0.0, 0.0, 0.0), Pose2::new(1.0, 1.0, FRAC_PI_2));
+        assert!(near(t, [FRAC_PI_2, 0.0, FRAC_PI_2]), "{t:?}");
+        // A turn on the spot.
+        let t = arc_twist(Pose2::new(0.5, 0.5, 0.3), Pose2::new(0.5, 0.5, 0.28));
+        assert!(near(t, [0.0, 0.0, -0.02]), "{t:?}");
+    }
+
+    #[test]
+    fn a_roll_goes_along_its_arc_at_a_speed_set_by_what_is_left_of_it() {
+        let feet = pairs_in_base(&robot(), &standing());
+        let near = |t: Twist, e: [f64; 3]| {
+            (t.vx - e[0]).abs() < 1e-12
+                && (t.vy - e[1]).abs() < 1e-12
+                && (t.wz - e[2]).abs() < 1e-12
+        };
+        // 3 cm to the right (−y), from the origin.
+        let arc = arc_twist(Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.0, -0.03, 0.0));
+        let target = Pose2::new(0.0, -0.03, 0.0);
+        // At the start: 2/s · 0.03 m = 0.06 m/s, capped at 0.03 m/s; 3 cm left.
+        let (t, left) = along_the_arc(Pose2::new(0.0, 0.0, 0.0), target, arc, &feet, 0.03);
+        assert!(near(t, [0.0, -0.03, 0.0]) && (left - 0.03).abs() < 1e-12, "{t:?} {left}");
+        // 1 cm left: 2/s · 0.01 m along −y; with the base also 1 cm ahead of the arc, only
+        // the part along the arc counts (the pairs keep their steering): the same.
+        let (t, left) = along_the_arc(Pose2::new(0.0, -0.02, 0.0), target, arc, &feet, 0.03);
+        assert!(near(t, [0.0, -0.02, 0.0]) && (left - 0.01).abs() < 1e-12, "{t:?} {left}");
+        let at = Pose2::new(0.01, -0.02, 0.0);
+        let (t, _) = along_the_arc(at, target, arc, &feet, 0.03);
+        assert!(near(t, [0.0, -0.02, 0.0]), "{t:?}");
+        // Half a centimetre past the end: back along the arc at 0.01 m/s.
+        let (t, left) = along_the_arc(Pose2::new(0.0, -0.035, 0.0), target, arc, &feet, 0.03);
+        assert!(near(t, [0.0, 0.01, 0.0]) && (left - 0.005).abs() < 1e-12, "{t:?} {left}");
+        // A turn of 0.02 rad on the spot: the farthest pair, √(0.35² + 0.32²) = 0.474 m out,
+        // has 9.5 mm to go, at 2/s: 0.04 rad/s.
+        let arc = arc_twist(Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.0, 0.0, 0.02));
+        let (t, left) =
+            along_the_arc(Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.0, 0.0, 0.02), arc, &feet, 0.03);
+        assert!(near(t, [0.0, 0.0, 0.04]), "{t:?}");
+        assert!((left - 0.02 * 0.35f64.hypot(0.32)).abs() < 1e-12, "{left}");
+        // No arc: nothing to do.
+        let none = Twist::default();
+        assert_eq!(along_the_arc(at, at, none, &feet, 0.03), (Twist::default(), 0.0));
+    }
+
+    #[test]
+    fn a_sliding_pair_keeps_the_steering_its_roll_was_checked_with() {
+        // Sliding 3 cm to the right (pairs steered to −90°); 2 cm done, the robot 1 cm
+        // ahead of its way and turned 0.01 rad by the steering's reaction. Pointing at the
+        // whole error left steered each pair elsewhere (−90° − 45° and more, each its own
+        // way with the turn): on a stair descent, four loaded pairs chasing the error's
+        // direction swung through 90° in 0.1 s and the robot fell (stairs seed 12072).
+        let (mut ex, mut o) = slide_started_3_cm_left();
+        o.steering = [-std::f64::consts::FRAC_PI_2; 4];
+        o.base = Pose2::new(0.01, 0.01, 0.01);
+        let (cmd, _) = ex.tick(&o, 0.01);
+        for w in cmd.wheels {
+            assert!((w.steer + std::f64::consts::FRAC_PI_2).abs() < 1e-9, "{w:?}");
+            // Rolling on, toward −y (forward along the steering), all pairs alike.
+            assert!(w.wheel_speeds[0] > 0.0, "{w:?}");
+            assert!((w.wheel_speeds[0] - cmd.wheels[0].wheel_speeds[0]).abs() < 1e-12);
+        }
+        assert!(matches!(ex.mode, Mode::Slide { .. }), "{:?}", ex.mode);
     }
 
     #[test]
