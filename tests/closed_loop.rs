@@ -96,6 +96,27 @@ fn a_bump_edge_driven_at_speed_does_not_launch_the_robot() {
     drives_generated_clutter_on_all_wheels(104);
 }
 
+/// A generated clutter field (`momaro generate --class clutter --seed 5171`) whose way
+/// takes a front pair off the edge of a 3.2 cm bump box. The base rose by every foot's
+/// whole rise, so a wheel resting on the edge the plan had its foot already off raised
+/// it although the leg beside stood on the box: the robot left the ground, 0.3 cm of
+/// margin. The base now rises only where a leg would come closer under its hip than the
+/// driving height.
+#[test]
+fn a_wheel_on_an_edge_its_longer_leg_takes_up_does_not_raise_the_base() {
+    drives_generated_clutter_on_all_wheels(5171);
+}
+
+/// A generated clutter field (`momaro generate --class clutter --seed 12067`) whose plan
+/// drops its base 3.3 cm between two poses as a front pair leaves a 4.3 cm box, the
+/// wheel still on the edge. The rise took that up only at its rate, so the command fell
+/// 3.3 cm in one tick and three pairs hung for 30 ms, the CoM outside the one pair down.
+/// The commanded base now comes down no faster than it may rise.
+#[test]
+fn a_plan_whose_base_drops_at_an_edge_keeps_the_wheels_loaded() {
+    drives_generated_clutter_on_all_wheels(12067);
+}
+
 /// Runs generated clutter seed `seed` (ARA*'s first solution) and asserts that it
 /// passes with at least 2 cm of margin and no static violation at all.
 fn drives_generated_clutter_on_all_wheels(seed: u64) {

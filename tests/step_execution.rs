@@ -7,7 +7,8 @@
 //! aborted step with its replan, a run stopped by a failure while the robot falls, a
 //! generated step down whose sunken base once carried a knee into the edge, and a
 //! generated flight off the grid's axes whose feet once drifted off their footholds, and a
-//! generated flight whose stance, turned by its rolls, once drifted until the robot fell.
+//! generated flight whose stance, turned by its rolls, once drifted until the robot fell,
+//! and a generated steep descent whose stance slide once turned the robot off its flight.
 
 mod common;
 
@@ -562,6 +563,35 @@ fn a_stance_turned_by_its_rolls_is_turned_back_and_both_flights_are_climbed() {
         .filter(|e| matches!(e.event, ExecEventKind::Slide { turned_rad, .. } if turned_rad.abs() > 0.01))
         .count();
     assert!(turns >= 2, "{:?}", s.executor_events);
+}
+
+#[test]
+fn a_stance_slid_back_on_a_steep_descent_keeps_its_pairs_steered_and_the_robot_upright() {
+    // Generated stairs seed 12072: eight 0.178 m rises on 0.272 m treads, down at −164.8°,
+    // open sides, with the stairs and wheel-pair models; the plan ARA*'s schedule reaches
+    // in 200,000 expansions (ε = 1.063, where `momaro run`'s 10 s limit stopped it). Before
+    // the 14th step, the robot pitched 23.5° with its rear pairs nearly unloaded, the
+    // stance slid back 2.5 cm in three rolls, each pointed every tick at the whole error
+    // left: the four loaded pairs chased the error's direction through 90° in 0.1 s, their
+    // steering torques turned the robot 7° on its wheels, and it pitched over its front
+    // pairs down the flight. Each roll now goes along its own arc, every pair at the
+    // steering it was checked with (`step_executor::slide`).
+    let sc = common::generated(momaro::scenario::generate::Class::Stairs, 12072);
+    let plan = PlanOptions {
+        time_limit_s: 600.0,
+        schedule_expansions: Some(200_000),
+        ..PlanOptions::default()
+    };
+    let s = run::run(&sc, &RunOptions::new(plan, common::model())).expect("run");
+    let rolled = s
+        .executor_events
+        .iter()
+        .filter(|e| matches!(e.event, ExecEventKind::Slide { rolls, .. } if rolls >= 2))
+        .count();
+    assert!(rolled >= 1, "{:?}", s.executor_events);
+    assert!(s.steps_planned >= 30, "{}", s.steps_planned);
+    assert_clean(&s);
+    assert!(s.passed, "{s:#?}");
 }
 
 #[test]

@@ -28,7 +28,7 @@ use super::{Command, ExecFailure, Mode, Observation, StepExecutor, planar};
 use crate::control::load_sharing::{WARP_SIGN, measured_warp, target_warp};
 use crate::control::path_follower::{FollowerStatus, PathFollower};
 use crate::geometry::wrap_angle;
-use crate::motion::kinematics::{Posture, interpolate};
+use crate::motion::kinematics::{Posture, hips_in_world, interpolate};
 
 /// How far a drive run moves a foot from its keyframe height to where its wheels rest,
 /// m: the foot cost's largest height difference within r_F (eq. 2), the most a wheel
@@ -41,15 +41,23 @@ impl StepExecutor {
     /// turned by its measured steering), within [`WHEEL_REST_RANGE_M`] of the keyframes'
     /// height: legs lengthen and shorten with the ground under the wheels, so every
     /// wheel keeps the ground over bumps the foot cost lets the robot drive on, rather
-    /// than the stiff legs lifting a diagonal off it. The base rises with the highest
-    /// foot's rise (as `motion::kinematics::driving_posture` sets it by the highest
-    /// foot): the driving height folds the knees nearly to their limit, so no leg may get
-    /// shorter than planned.
+    /// than the stiff legs lifting a diagonal off it. The base rises where a foot would
+    /// otherwise stand closer under its hip than the driving leg height (the knees fold
+    /// nearly to their limit there): by the most any foot rises beyond its leg's
+    /// [`Self::leg_slack`]. A driving posture sets the base by its highest foot
+    /// (`motion::kinematics::driving_posture`), so only that leg is at the driving height;
+    /// a wheel resting on the edge of a bump the plan has it already off is taken up by
+    /// its longer leg. (The base rose by each foot's whole rise before: a front pair
+    /// rolling off a 4.3 cm box, its wheels still on the edge where the map had its foot
+    /// on the floor, raised the base 3.5 cm while its partner stood on the box, and the
+    /// rise and the load sharing's push threw every wheel off the ground: generated
+    /// clutter seed 12067, the CoM 2.7 cm outside the support of the first wheels down.)
     fn on_wheel_rest_heights(&self, mut p: Posture, obs: &Observation) -> Posture {
         let mut rise = 0.0_f64;
         let r = self.robot.wheel_radius;
         let half_track = self.robot.wheel_track / 2.0;
         let planned = planar(&p);
+        let slack = self.leg_slack(&p);
         for (i, f) in p.feet.iter_mut().enumerate() {
             // Where the wheels are: the foot's place under the base as measured, not under
             // the keyframes' pose, which the robot follows only within the follower's
@@ -66,7 +74,7 @@ impl StepExecutor {
                 .fold(None, |a: Option<f64>, z| Some(a.map_or(z, |a| a.max(z))));
             if let Some(z) = rest {
                 let z = z.clamp(f[2] - WHEEL_REST_RANGE_M, top);
-                rise = rise.max(z - f[2]);
+                rise = rise.max(z - f[2] - slack[i]);
                 f[2] = z;
             }
         }
@@ -74,10 +82,21 @@ impl StepExecutor {
         p
     }
 
+    /// How much longer than the driving leg height each leg of `p` is (hip over foot, m,
+    /// at least zero): how far its foot may rise under an unmoved base.
+    fn leg_slack(&self, p: &Posture) -> [f64; 4] {
+        let hips = hips_in_world(&self.robot, p);
+        std::array::from_fn(|i| {
+            (hips[i][2] - p.feet[i][2] - self.config.driving_leg_height_m).max(0.0)
+        })
+    }
+
     /// `rest` (`planned` on the wheels' rest heights, [`Self::on_wheel_rest_heights`])
     /// with the base's rise moved toward its rise there by at most
-    /// `base_rise_speed_mps · dt` since the last tick, and each foot no higher than the
-    /// leg's planned length allows from that base (no leg shorter than planned). Followed
+    /// `base_rise_speed_mps · dt` since the last tick, the base commanded no more than
+    /// that below its last command, and each foot no higher than the
+    /// driving leg height allows under that base ([`Self::leg_slack`]: no leg shorter
+    /// than the knees fold to). Followed
     /// at once, a wheel pair driven onto a 3.7 cm box edge at 0.45 m/s raised the base at
     /// 0.5 m/s, and when the rise stopped the robot flew on: every wheel off the ground
     /// for 60 ms, the CoM 0.25 m outside the support of the wheels that first came down.
@@ -87,9 +106,22 @@ impl StepExecutor {
         let target = rest.base_position[2] - planned.base_position[2];
         let step = self.config.base_rise_speed_mps * dt;
         self.drive_rise += (target - self.drive_rise).clamp(-step, step);
-        rest.base_position[2] = planned.base_position[2] + self.drive_rise;
-        for (f, q) in rest.feet.iter_mut().zip(&planned.feet) {
-            f[2] = f[2].min(q[2] + self.drive_rise);
+        // Nor does the commanded base come down faster: where the plan's base drops
+        // between two poses while a wheel still rests on the edge it leaves, the rise
+        // takes the drop up only at its rate, and the base commanded 3.3 cm lower in one
+        // tick left three pairs hanging (generated clutter seed 12067, ε = 3: the CoM
+        // outside the one pair down for 30 ms). Legs that shorten no faster than the
+        // robot falls in a millimetre keep their wheels loaded.
+        let mut z = planned.base_position[2] + self.drive_rise;
+        if let Some(last) = self.drive_base_z {
+            z = z.max(last - step);
+        }
+        self.drive_rise = z - planned.base_position[2];
+        self.drive_base_z = Some(z);
+        rest.base_position[2] = z;
+        let slack = self.leg_slack(planned);
+        for ((f, q), s) in rest.feet.iter_mut().zip(&planned.feet).zip(slack) {
+            f[2] = f[2].min(q[2] + s + self.drive_rise);
         }
         rest
     }
@@ -218,16 +250,61 @@ mod tests {
     use crate::control::step_executor::StepExecutor;
     use crate::control::step_executor::test_support::{config, obs, robot, standing, step_path};
     use crate::geometry::Pose2;
+    use crate::motion::kinematics::Posture;
     use crate::terrain::HeightMap;
 
     /// A 4 cm bump under the front-left foot's keyframe position (hip at (0.35, 0.32),
     /// the bump covering x ∈ [0.25, 0.45], y ∈ [0.2, 0.45]).
     fn front_left_bump() -> HeightMap {
+        bump(0.2..0.45, 0.04)
+    }
+
+    /// A box `height` high under both front pairs (x ∈ [0.25, 0.45], y ∈ [−0.45, 0.45]).
+    fn front_box(height: f64) -> HeightMap {
+        bump(-0.45..0.45, height)
+    }
+
+    /// A box `height` high over x ∈ [0.25, 0.45] and `across` in y.
+    fn bump(across: std::ops::Range<f64>, height: f64) -> HeightMap {
         HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |i, j| {
             let (x, y) = (-2.0 + (i as f64 + 0.5) * 0.025, -2.0 + (j as f64 + 0.5) * 0.025);
-            if (0.25..0.45).contains(&x) && (0.2..0.45).contains(&y) { 0.04 } else { 0.0 }
+            if (0.25..0.45).contains(&x) && across.contains(&y) { height } else { 0.0 }
         })
         .unwrap()
+    }
+
+    /// The reference robot at the driving height on flat ground: level, every hip the
+    /// driving leg height over its foot (the knees folded nearly to their limit).
+    fn driving() -> Posture {
+        let mut p = standing();
+        p.base_position[2] = config().driving_leg_height_m - robot().hips[0][2];
+        p
+    }
+
+    #[test]
+    fn a_leg_longer_than_the_driving_height_takes_up_a_wheel_on_an_edge() {
+        // A 4.3 cm box under both front pairs; the plan has the front-left foot on it (the
+        // base set by it, the leg at the driving height) and the front-right still on the
+        // floor, its leg 4.3 cm longer. The front-right wheels rest on the box: its leg
+        // takes that up, and the base does not rise (it rose 4.3 cm when any foot's rise
+        // counted whole, which threw the robot off its wheels on generated clutter).
+        let ex = StepExecutor::new(&robot(), config(), step_path(), front_box(0.043));
+        let mut p = driving();
+        p.feet[0][2] = 0.043;
+        p.base_position[2] += 0.043;
+        let o = obs(0.0, &ex, &[], [0.0; 3]);
+        let q = ex.on_wheel_rest_heights(p, &o);
+        assert!((q.base_position[2] - p.base_position[2]).abs() < 1e-12, "{q:?}");
+        assert!((q.feet[1][2] - 0.043).abs() < 1e-12, "{q:?}");
+        // Nor does the limited rise hold the front-right foot down at its planned height.
+        let mut ex = ex;
+        let r = ex.with_limited_rise(&p, q, 0.01);
+        assert!((r.base_position[2] - q.base_position[2]).abs() < 1e-12, "{r:?}");
+        assert!((0..4).all(|i| (r.feet[i][2] - q.feet[i][2]).abs() < 1e-12), "{r:?}");
+        // Both front feet planned on the floor: the front pair at the driving height on
+        // its 4.3 cm rises the base by that.
+        let q = ex.on_wheel_rest_heights(driving(), &o);
+        assert!((q.base_position[2] - driving().base_position[2] - 0.043).abs() < 1e-12);
     }
 
     #[test]
@@ -236,7 +313,7 @@ mod tests {
         // front-left wheels rest on the bump and the base rises 4 cm; with the base
         // measured 0.3 m behind, the wheels stand on the floor and nothing rises.
         let ex = StepExecutor::new(&robot(), config(), step_path(), front_left_bump());
-        let p = standing();
+        let p = driving();
         let mut o = obs(0.0, &ex, &[], [0.0; 3]);
         let rise = |o: &crate::control::step_executor::Observation| {
             ex.on_wheel_rest_heights(p, o).base_position[2] - p.base_position[2]
@@ -248,13 +325,13 @@ mod tests {
 
     #[test]
     fn the_base_rises_onto_a_bump_no_faster_than_its_rise_speed() {
-        // The 4 cm bump of the test above under the front-left wheels: the rest heights
-        // raise the base 4 cm at once; the command rises √(2 g · 1 mm) = 0.140 m/s, so
+        // The 4 cm bump of the test above under the front-left wheels, the robot at the
+        // driving height: the rest heights raise the base 4 cm at once; the command rises √(2 g · 1 mm) = 0.140 m/s, so
         // 1.40 mm per 10 ms tick, the front-left foot held at its planned leg length
         // (1.40 mm up, not 4 cm); 29 ticks reach the 4 cm, and off the bump it comes
         // down as slowly.
         let mut ex = StepExecutor::new(&robot(), config(), step_path(), front_left_bump());
-        let p = standing();
+        let p = driving();
         let on = obs(0.0, &ex, &[], [0.0; 3]);
         let mut off = obs(0.0, &ex, &[], [0.0; 3]);
         off.base = Pose2::new(-0.3, 0.0, 0.0);
@@ -279,6 +356,34 @@ mod tests {
         let q = tick(&mut ex, &off);
         assert!((q.base_position[2] - p.base_position[2] - (0.04 - v * 0.01)).abs() < 1e-12);
         assert!((0..4).all(|i| q.feet[i][2] == p.feet[i][2]));
+    }
+
+    #[test]
+    fn the_base_comes_down_no_faster_than_it_may_rise() {
+        // Flat ground, the robot at the driving height. The plan's base drops 3.3 cm
+        // from one tick to the next while the wheels' rest heights keep it where it was
+        // (a wheel still on the edge of the box the plan has it off): the command comes
+        // down one tick's 1.40 mm, not 3.3 cm less the rise's 1.40 mm. Where the rest
+        // heights drop with the plan, it comes down 1.40 mm a tick until it is there.
+        let flat = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |_, _| 0.0).unwrap();
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), flat);
+        let step = ex.config.base_rise_speed_mps * 0.01;
+        let p = driving();
+        let z = p.base_position[2];
+        let q = ex.with_limited_rise(&p, p, 0.01);
+        assert!((q.base_position[2] - z).abs() < 1e-12);
+        let mut lower = p;
+        lower.base_position[2] -= 0.033;
+        let q = ex.with_limited_rise(&lower, p, 0.01);
+        assert!((q.base_position[2] - (z - step)).abs() < 1e-12, "{q:?}");
+        let mut last = q.base_position[2];
+        for _ in 0..40 {
+            let q = ex.with_limited_rise(&lower, lower, 0.01);
+            let dz = last - q.base_position[2];
+            assert!((-1e-12..=step + 1e-12).contains(&dz), "{dz}");
+            last = q.base_position[2];
+        }
+        assert!((last - (z - 0.033)).abs() < 1e-12, "{last}");
     }
 
     #[test]

@@ -220,6 +220,9 @@ pub struct StepExecutor {
     drive_extension: [f64; 4],
     /// A drive run's rise of the base with the ground under its wheels, m (`drive`).
     drive_rise: f64,
+    /// A drive run's last commanded base height, m (`drive`: it comes down no faster than
+    /// it may rise); `None` before the run's first tick.
+    drive_base_z: Option<f64>,
     /// Stabilising base correction (plan coordinates), m.
     correction: [f64; 2],
     /// The correction at the start of the segment that fades it out.
@@ -280,6 +283,7 @@ impl StepExecutor {
             foot_offset: [[0.0; 3]; 4],
             drive_extension: [0.0; 4],
             drive_rise: 0.0,
+            drive_base_z: None,
             correction: [0.0; 2],
             fading: None,
             lift_offset: [0.0; 3],
@@ -374,6 +378,7 @@ impl StepExecutor {
                         let max = self.config.max_leg_extension_m;
                         self.drive_extension = self.foot_offset.map(|o| (-o[2]).clamp(0.0, max));
                         self.drive_rise = 0.0;
+                        self.drive_base_z = None;
                         self.foot_offset = [[0.0; 3]; 4];
                         self.correction = [0.0; 2];
                         self.fading = None;
