@@ -94,14 +94,13 @@ impl StepExecutor {
     /// `rest` (`planned` on the wheels' rest heights, [`Self::on_wheel_rest_heights`])
     /// with the base's rise moved toward its rise there by at most
     /// `base_rise_speed_mps · dt` since the last tick, the base commanded no more than
-    /// that below its last command, and each foot no higher than the
-    /// driving leg height allows under that base ([`Self::leg_slack`]: no leg shorter
-    /// than the knees fold to). Followed
-    /// at once, a wheel pair driven onto a 3.7 cm box edge at 0.45 m/s raised the base at
-    /// 0.5 m/s, and when the rise stopped the robot flew on: every wheel off the ground
-    /// for 60 ms, the CoM 0.25 m outside the support of the wheels that first came down.
-    /// A wheel that climbs faster than the base may rise presses into its bump instead,
-    /// which lifts that side as it would a rigid cart.
+    /// that below its last command, and each foot no higher than the driving leg height
+    /// allows under that base ([`Self::leg_slack`]: no leg shorter than the knees fold
+    /// to). Followed at once, a wheel pair driven onto a 3.7 cm box edge at 0.45 m/s
+    /// raised the base at 0.5 m/s, and when the rise stopped the robot flew on: every
+    /// wheel off the ground for 60 ms, the CoM 0.25 m outside the support of the wheels
+    /// that first came down. A wheel that climbs faster than the base may rise presses
+    /// into its bump instead, which lifts that side as it would a rigid cart.
     fn with_limited_rise(&mut self, planned: &Posture, mut rest: Posture, dt: f64) -> Posture {
         let target = rest.base_position[2] - planned.base_position[2];
         let step = self.config.base_rise_speed_mps * dt;
@@ -326,10 +325,10 @@ mod tests {
     #[test]
     fn the_base_rises_onto_a_bump_no_faster_than_its_rise_speed() {
         // The 4 cm bump of the test above under the front-left wheels, the robot at the
-        // driving height: the rest heights raise the base 4 cm at once; the command rises √(2 g · 1 mm) = 0.140 m/s, so
-        // 1.40 mm per 10 ms tick, the front-left foot held at its planned leg length
-        // (1.40 mm up, not 4 cm); 29 ticks reach the 4 cm, and off the bump it comes
-        // down as slowly.
+        // driving height: the rest heights raise the base 4 cm at once; the command rises
+        // √(2 g · 1 mm) = 0.140 m/s, so 1.40 mm per 10 ms tick, the front-left foot held
+        // at its planned leg length (1.40 mm up, not 4 cm); 29 ticks reach the 4 cm, and
+        // off the bump it comes down as slowly.
         let mut ex = StepExecutor::new(&robot(), config(), step_path(), front_left_bump());
         let p = driving();
         let on = obs(0.0, &ex, &[], [0.0; 3]);

@@ -708,7 +708,7 @@ mod tests {
                 && (t.vy - e[1]).abs() < 1e-12
                 && (t.wz - e[2]).abs() < 1e-12
         };
-        // 1 cm along −x in the world at heading 90°: the robot's +y' (its right is −x).
+        // 1 cm along −x in the world at heading 90°: the robot's +y' (its left is −x).
         let t = arc_twist(Pose2::new(0.0, 0.0, FRAC_PI_2), Pose2::new(-0.01, 0.0, FRAC_PI_2));
         assert!(near(t, [0.0, 0.01, 0.0]), "{t:?}");
         // A quarter circle of radius 1 to the left, (0, 0, 0) to (1, 1, 90°): forward at
