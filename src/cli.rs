@@ -519,8 +519,6 @@ fn check_error(e: jobs::check::CheckError) -> anyhow::Error {
     }
 }
 
-/// `momaro check`: the suite's rows on stderr as they finish, then the table (or JSON) in
-/// the suite's order on stdout.
 /// The scenario files of a suite (`check`, `bench probe`): those below `paths`, sorted
 /// and de-duplicated, or every scenarios/*.toml of the repository if none is given.
 fn suite_files(paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
@@ -533,6 +531,8 @@ fn suite_files(paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     .map_err(check_error)
 }
 
+/// `momaro check`: the suite's rows on stderr as they finish, then the table (or JSON) in
+/// the suite's order on stdout.
 fn check(
     paths: &[PathBuf],
     planner: &PlannerArgs,

@@ -565,11 +565,14 @@ impl StepExecutor {
         let target = |k: usize| rolls[..=k].iter().fold(start, |b, r| r.apply_pose(b));
         let arc = |k: usize| arc_twist(if k == 0 { start } else { target(k - 1) }, target(k));
         let toward = |k: usize| along_the_arc(obs.base, target(k), arc(k), &feet, max_speed);
-        let done = |k: usize| toward(k).1 < SLIDE_DONE_M;
-        while rolling && roll + 1 < rolls.len() && done(roll) {
+        // The roll under way and what it commands; a roll with less than `SLIDE_DONE_M`
+        // of its arc left is done.
+        let (mut twist, mut left) = toward(roll);
+        while rolling && roll + 1 < rolls.len() && left < SLIDE_DONE_M {
             roll += 1;
+            (twist, left) = toward(roll);
         }
-        if rolling && (done(roll) || out_of_time) {
+        if rolling && (left < SLIDE_DONE_M || out_of_time) {
             rolling = false;
         }
         if !rolling {
@@ -582,7 +585,6 @@ impl StepExecutor {
             }
             return Command { legs, wheels: self.rolling(&p, &[[0.0; 2]; 4], obs) };
         }
-        let (twist, _) = toward(roll);
         let wheels = c.wheels.commands(&self.robot, twist, &feet, &obs.steering);
         self.mode = Mode::Slide { index, start, rolls, roll, elapsed: elapsed + dt, rolling };
         Command { legs, wheels: self.with_steer_rate(wheels, obs) }
