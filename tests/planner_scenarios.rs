@@ -501,3 +501,25 @@ fn a_guided_probe_climbs_open_sided_stairs_its_heuristic_alone_floods_beside() {
         assert!(steps(&p).len() >= 8, "seed {seed}: every foot climbs");
     }
 }
+
+#[test]
+fn the_probe_steps_down_0_3_m_without_first_searching_the_whole_platform() {
+    // Before its first step down the base shifts forward over the edge, leaving all four
+    // feet behind neutral. The probe's greedy list weighed each foot's offset as the
+    // heuristic does (1.34 per metre, four feet) against 1 per metre of the straight
+    // line, so that shift stood on a hill it crossed only after the whole platform at
+    // every heading: 98,285 expansions. Weighed at a quarter each, the shift is level:
+    // 30,427.
+    let probe_only = PlanOptions {
+        final_epsilon: Some(3.0),
+        schedule_expansions: Some(0),
+        max_expansions: Some(60_000),
+        ..arastar(600.0)
+    };
+    let p = plan(&scenario("step_down"), &probe_only);
+    let probe = &p.solutions[0];
+    assert_eq!(probe.epsilon, 50.0);
+    assert!(probe.expansions < 40_000, "{} expansions", probe.expansions);
+    assert!((1.0..=50.0).contains(&probe.suboptimality_bound));
+    assert_eq!(steps(&p).len(), 4, "every foot steps down once");
+}

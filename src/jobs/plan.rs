@@ -58,7 +58,9 @@ pub struct PlanOptions {
     /// Whether ARA*'s probe is guided (`SearchParams::probe_guidance`: every other
     /// expansion ordered by the heuristic without its base-pose cost-to-go,
     /// `HeuristicParts::guidance`, and after `SearchParams::probe_greedy_after`
-    /// expansions without a path every third by that guidance alone). Default true.
+    /// expansions without a path every third by a guidance alone, the same with the feet's
+    /// offsets weighed as the straight line weighs the base's way,
+    /// `HeuristicParts::greedy_guidance`). Default true.
     pub probe_guidance: bool,
     /// Expansions ARA*'s schedule may spend after its probe found a path
     /// (`SearchParams::schedule_max_expansions`): the probe's path is then the answer

@@ -339,17 +339,20 @@ impl StepBound {
     /// [`offset_potential`]). Exact integers: c is a whole number of micro-units.
     #[inline]
     pub fn offset_potential(&self, o: &[i8; 4]) -> (Cost, Cost) {
-        let (mut behind, mut ahead) = (0u64, 0u64);
-        for &v in o {
-            if v < 0 {
-                behind += u64::from(v.unsigned_abs());
-            } else {
-                ahead += u64::from(v.unsigned_abs());
-            }
-        }
+        let (behind, ahead) = offset_cells(o);
         let c = self.offset_per_cell.0;
         (Cost(c.saturating_mul(behind)), Cost(c.saturating_mul(ahead)))
     }
+}
+
+/// The cells the feet of offsets `o` stand behind neutral and ahead of it, summed over
+/// the four feet: `(Σ o⁻, Σ o⁺)`.
+#[inline]
+pub fn offset_cells(o: &[i8; 4]) -> (u64, u64) {
+    o.iter().fold((0, 0), |(behind, ahead), &v| {
+        let cells = u64::from(v.unsigned_abs());
+        if v < 0 { (behind + cells, ahead) } else { (behind, ahead + cells) }
+    })
 }
 
 /// Which component pairs a step could join at all (criterion 3 over the whole swing).

@@ -615,6 +615,34 @@ mod hybrid {
     }
 
     #[test]
+    fn a_base_shift_toward_the_goal_leaves_the_greedy_lists_estimate_level() {
+        // The base 0.3 m nearer the goal straight ahead, all four feet where they stood
+        // (0.3 m behind neutral): the straight line drops by 0.3, the offsets' share of
+        // the greedy list's estimate rises by 4 × 0.25 × 0.3. At the heuristic's own
+        // weight (c = f · k11 · C_F,min = 10.75 · 0.125 = 1.34 per metre) the guidance
+        // rises by 4c · 0.3 − 0.3 = 1.3125, a hill the greedy list, ordered by it, crossed
+        // only after every state below it.
+        let maps = platform_maps(0.2);
+        let mut g = graph(&maps, state_on(&maps, 2.5, 0.0, 0.0));
+        let s = state_at(&g, -0.5, 0.0);
+        let t = state_at(&g, -0.2, 0.0);
+        assert_eq!(t.i - s.i, 12);
+        let t = g.with_offsets(t, [-12; 4]).expect("interned");
+        let (before, after) = (g.heuristic_parts(s), g.heuristic_parts(t));
+        assert_eq!(before.steps, after.steps, "the feet stand where they stood");
+        let drop = before.driving.0 as i64 - after.driving.0 as i64;
+        assert!((drop - Cost::from_f64(0.3).0 as i64).abs() <= 2, "{drop}");
+        let rise = after.greedy_guidance().0 as i64 - before.greedy_guidance().0 as i64;
+        assert!(rise.abs() <= 2, "the greedy estimate moved by {rise} micro-units");
+        let hill = after.guidance().to_f64() - before.guidance().to_f64();
+        assert!((hill - 1.3125).abs() < 1e-4, "{hill}");
+        // The heuristic itself keeps Φ at c (its cost-to-go pays for the rise), per cell
+        // rounded down to the micro-unit.
+        let c = Params::default().step_cost_factor * Params::default().k11;
+        assert!((after.behind.to_f64() - 4.0 * c * 0.3).abs() < 1e-4, "{:?}", after.behind);
+    }
+
+    #[test]
     fn feet_back_to_neutral_one_at_a_time_cost_eq_6() {
         let maps = platform_maps(0.2);
         let mut g = graph(&maps, LatticeState::new(0, 0, 0));
@@ -1284,7 +1312,8 @@ mod hybrid {
 
 #[test]
 fn the_probes_guidance_is_the_heuristic_without_its_cost_to_go() {
-    // h = max(2, 15) + 30 + 1 − 0.5 = 45.5; guidance = 2 + 30 + 1 − 0.5 = 32.5.
+    // h = max(2, 15) + 30 + 1 − 0.5 = 45.5; guidance = 2 + 30 + 1 − 0.5 = 32.5; the
+    // greedy list's = 2 + 30 + 0.25 − 0.125 = 32.125 (the offsets at its own weight).
     let u = |v: f64| Cost::from_f64(v);
     let p = HeuristicParts {
         reachable: Cost::ZERO,
@@ -1293,12 +1322,15 @@ fn the_probes_guidance_is_the_heuristic_without_its_cost_to_go() {
         steps: u(30.0),
         behind: u(1.0),
         ahead: u(0.5),
+        greedy_behind: u(0.25),
+        greedy_ahead: u(0.125),
     };
     assert_eq!(p.total(), u(45.5));
-    assert_eq!(p.guidance(), u(32.5));
+    assert_eq!((p.guidance(), p.greedy_guidance()), (u(32.5), u(32.125)));
     // Never above the heuristic; clamped at zero; infinite where the base cannot reach.
-    let ahead = HeuristicParts { ahead: u(40.0), ..p };
+    let ahead = HeuristicParts { ahead: u(40.0), greedy_ahead: u(40.0), ..p };
     assert_eq!((ahead.total(), ahead.guidance()), (u(6.0), Cost::ZERO));
+    assert_eq!(ahead.greedy_guidance(), Cost::ZERO);
     let unreachable = HeuristicParts { reachable: Cost::INFINITY, ..p };
-    assert!(unreachable.guidance().is_infinite());
+    assert!(unreachable.guidance().is_infinite() && unreachable.greedy_guidance().is_infinite());
 }

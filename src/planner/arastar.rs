@@ -39,7 +39,8 @@
 //! heuristic alone was the better guide, alternating costs expansions (a generated mixed
 //! course: 170 → 1,041). A probe that has reached no goal after
 //! `SearchParams::probe_greedy_after` expansions (20,000) adds a third list, ordered by
-//! the guidance alone (greedy best-first): where one edge costs more than ε times the
+//! a guidance alone (greedy best-first; the graph may offer it a guidance of its own,
+//! `SearchGraph::heuristic_and_guidances`): where one edge costs more than ε times the
 //! heuristic's drop over it, both weighted lists expand every state keyed below its far
 //! side first. On a generated two-step flight whose every tread foothold lies near an
 //! edge (a step onto the first tread about 440, the heuristic's bound for it about 10),

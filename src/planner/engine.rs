@@ -10,7 +10,8 @@
 //! `g + ε·h`) a second list of the same states ordered by `g + ε·guidance`
 //! ([`SearchGraph::heuristic_and_guidance`]), and, once the search has made
 //! `SearchParams::probe_greedy_after` expansions without reaching a goal, a third,
-//! *greedy* one, ordered by the guidance alone (ties: the smaller `g`); expansions are
+//! *greedy* one, ordered by a guidance alone (ties: the smaller `g`), its own if the graph
+//! offers one ([`SearchGraph::heuristic_and_guidances`]); expansions are
 //! taken from the lists in turn (the alternation of Röger & Helmert, "The More, the
 //! Merrier: Combining Heuristic Estimators for Satisficing Planning", ICAPS 2010). Every
 //! OPEN state is in every list and a state is closed whichever list it leaves by, so it
@@ -46,7 +47,8 @@ pub(crate) struct Engine<'g, 'h, G: SearchGraph> {
     pub open: OpenList,
     /// The guidance-ordered OPEN list of a guided search (see the module docs).
     guide: Option<OpenList>,
-    /// The greedy list of a guided search: by guidance alone, ties by `g` (module docs).
+    /// The greedy list of a guided search: by its guidance alone, ties by `g` (module
+    /// docs).
     greedy: Option<OpenList>,
     /// Which list the next expansion comes from (0: OPEN, 1: `guide`, 2: `greedy`).
     turn: u8,
@@ -120,7 +122,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
             // empty and the search ends at once with no path.
             if goal || !h.is_infinite() {
                 n.set_open(true);
-                let guidance = n.guidance;
+                let guidance = (n.guidance, n.greedy);
                 let lists = OpenLists::of(&mut self.open, &mut self.guide, &mut self.greedy);
                 lists.push(id, Cost::ZERO, h, guidance, eps);
             }
@@ -179,7 +181,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
         for e in self.open.iter() {
             if Self::is_valid(&self.store, e, self.eps) {
                 let n = self.store.get(e.node);
-                greedy.push(greedy_entry(e.node, n.g, n.guidance));
+                greedy.push(greedy_entry(e.node, n.g, n.greedy));
             }
         }
         self.greedy = Some(greedy);
@@ -190,7 +192,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
     #[inline]
     fn is_valid_greedy(store: &NodeStore<G::State>, e: &Entry) -> bool {
         let n = store.get(e.node);
-        n.in_open() && greedy_entry(e.node, n.g, n.guidance) == *e
+        n.in_open() && greedy_entry(e.node, n.g, n.greedy) == *e
     }
 
     /// `ImprovePath()`: expand states in key order until the best goal's key is at most
@@ -227,7 +229,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 // while fvalue(s_goal) > min_{s ∈ OPEN} fvalue(s)
                 if weighted_key(gn.g, gn.h, eps) <= top.key
                     || guided_top.is_some_and(|t| weighted_key(gn.g, gn.guidance, eps) <= t.key)
-                    || greedy_top.is_some_and(|t| gn.guidance.0 <= t.key)
+                    || greedy_top.is_some_and(|t| gn.greedy.0 <= t.key)
                 {
                     return Ok(());
                 }
@@ -310,7 +312,7 @@ impl<'g, 'h, G: SearchGraph> Engine<'g, 'h, G> {
                 }
                 // lines 09–10: if s' ∉ CLOSED, insert/update s' in OPEN with fvalue(s')
                 tn.set_open(true);
-                let (h, guidance) = (tn.h, tn.guidance);
+                let (h, guidance) = (tn.h, (tn.guidance, tn.greedy));
                 let lists = OpenLists::of(&mut self.open, &mut self.guide, &mut self.greedy);
                 lists.push(tid, ng, h, guidance, eps);
             }
@@ -426,16 +428,16 @@ impl<'a> OpenLists<'a> {
         Self { open, guide: guide.as_mut(), greedy: greedy.as_mut() }
     }
 
-    /// Inserts node `id` (cost `g`, heuristic `h`, guidance `guidance`) into every list
-    /// at ε `eps`.
+    /// Inserts node `id` (cost `g`, heuristic `h`, the guidance of the guidance-ordered
+    /// list and of the greedy one `(guide, greedy)`) into every list at ε `eps`.
     #[inline]
-    fn push(self, id: NodeId, g: Cost, h: Cost, guidance: Cost, eps: u64) {
+    fn push(self, id: NodeId, g: Cost, h: Cost, (guide_h, greedy_h): (Cost, Cost), eps: u64) {
         self.open.push(Entry { key: weighted_key(g, h, eps), h: h.0, node: id });
         if let Some(guide) = self.guide {
-            guide.push(Entry { key: weighted_key(g, guidance, eps), h: guidance.0, node: id });
+            guide.push(Entry { key: weighted_key(g, guide_h, eps), h: guide_h.0, node: id });
         }
         if let Some(greedy) = self.greedy {
-            greedy.push(greedy_entry(id, g, guidance));
+            greedy.push(greedy_entry(id, g, greedy_h));
         }
     }
 }

@@ -49,6 +49,14 @@ pub trait SearchGraph {
         (h, h)
     }
 
+    /// Optional: [`heuristic_and_guidance`](Self::heuristic_and_guidance) and a second
+    /// guidance for the probe's greedy list (`engine` module docs). The default is the
+    /// one guidance for both lists.
+    fn heuristic_and_guidances(&self, state: Self::State) -> (Cost, Cost, Cost) {
+        let (h, guidance) = self.heuristic_and_guidance(state);
+        (h, guidance, guidance)
+    }
+
     /// Optional: whether `state` is the intermediate node of a lazily evaluated edge
     /// (default: none is). A graph may split an edge whose validity is expensive to check
     /// into a cheap edge, at a lower bound of its cost, to an intermediate node, and the
@@ -102,6 +110,10 @@ impl<G: SearchGraph + ?Sized> SearchGraph for &mut G {
 
     fn heuristic_and_guidance(&self, state: Self::State) -> (Cost, Cost) {
         (**self).heuristic_and_guidance(state)
+    }
+
+    fn heuristic_and_guidances(&self, state: Self::State) -> (Cost, Cost, Cost) {
+        (**self).heuristic_and_guidances(state)
     }
 
     fn is_intermediate(&self, state: Self::State) -> bool {

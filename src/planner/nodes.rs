@@ -2,7 +2,7 @@
 //! `Vec` of compact node records, a deterministic Fx-style hasher, the limit checks
 //! (time, cancel, expansions) and path reconstruction.
 //!
-//! A node record is the state plus 32 bytes (`g`, cached `h` and guidance, parent id, and
+//! A node record is the state plus 40 bytes (`g`, cached `h` and two guidances, parent id, and
 //! a packed word holding the CLOSED iteration and the OPEN / INCONS / goal flags), so ARA*'s
 //! "CLOSED = ∅" at the start of each iteration is O(1): a state is closed only if it was
 //! closed *in the current iteration*.
@@ -118,6 +118,8 @@ pub(crate) struct Node<S> {
     /// Cached guidance ([`SearchGraph::heuristic_and_guidance`]) in a guided store, else
     /// equal to `h`.
     pub guidance: Cost,
+    /// Cached guidance of the greedy list (`SearchGraph::heuristic_and_guidances`).
+    pub greedy: Cost,
     /// Predecessor on the best known path.
     pub parent: NodeId,
     /// Bits 0–28: iteration + 1 in which the node was last closed (0: never);
@@ -219,13 +221,21 @@ impl<S: Copy + Eq + std::hash::Hash> NodeStore<S> {
         }
         let id = self.nodes.len() as NodeId;
         let meta = if graph.is_goal(state) { GOAL } else { 0 };
-        let (h, guidance) = if self.guided {
-            graph.heuristic_and_guidance(state)
+        let (h, guidance, greedy) = if self.guided {
+            graph.heuristic_and_guidances(state)
         } else {
             let h = graph.heuristic(state);
-            (h, h)
+            (h, h, h)
         };
-        self.nodes.push(Node { state, g: Cost::INFINITY, h, guidance, parent: NO_NODE, meta });
+        self.nodes.push(Node {
+            state,
+            g: Cost::INFINITY,
+            h,
+            guidance,
+            greedy,
+            parent: NO_NODE,
+            meta,
+        });
         Some(id)
     }
 
@@ -406,6 +416,7 @@ mod tests {
             g: Cost::ZERO,
             h: Cost::ZERO,
             guidance: Cost::ZERO,
+            greedy: Cost::ZERO,
             parent: NO_NODE,
             meta: GOAL,
         };

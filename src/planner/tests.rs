@@ -17,6 +17,9 @@ struct Table {
     goal: u8,
     /// Guidance per state (`SearchGraph::heuristic_and_guidance`); none: the heuristic.
     guidance: Option<Vec<u64>>,
+    /// The greedy list's guidance per state (`SearchGraph::heuristic_and_guidances`);
+    /// none: the guidance.
+    greedy: Option<Vec<u64>>,
 }
 
 impl SearchGraph for Table {
@@ -38,6 +41,10 @@ impl SearchGraph for Table {
         let h = self.heuristic(s);
         (h, self.guidance.as_ref().map_or(h, |g| Cost(g[s as usize] * Cost::SCALE)))
     }
+    fn heuristic_and_guidances(&self, s: u8) -> (Cost, Cost, Cost) {
+        let (h, guidance) = self.heuristic_and_guidance(s);
+        (h, guidance, self.greedy.as_ref().map_or(guidance, |g| Cost(g[s as usize] * Cost::SCALE)))
+    }
 }
 
 const S: u8 = 0;
@@ -53,6 +60,7 @@ fn trap() -> Table {
         h: vec![1, 0, 1, 0],
         goal: G,
         guidance: None,
+        greedy: None,
     }
 }
 
@@ -136,19 +144,25 @@ fn dear_edge() -> Table {
     h[A as usize] = 1;
     h[G as usize] = 0;
     h[B as usize] = 2;
-    Table { edges, h, goal: G, guidance: None }
+    Table { edges, h, goal: G, guidance: None, greedy: None }
 }
 
-#[test]
-fn a_guided_probes_greedy_list_crosses_a_dear_edge_and_reports_its_true_bound() {
-    let p = SearchParams {
+/// A guided probe (ε = 10) whose greedy list joins from the start, and no schedule after
+/// it.
+fn greedy_probe() -> SearchParams {
+    SearchParams {
         probe_epsilon: Some(10.0),
         initial_epsilon: 3.0,
         final_epsilon: 3.0,
         schedule_max_expansions: Some(0),
         probe_greedy_after: Some(0),
         ..SearchParams::default()
-    };
+    }
+}
+
+#[test]
+fn a_guided_probes_greedy_list_crosses_a_dear_edge_and_reports_its_true_bound() {
+    let p = greedy_probe();
     // Guided: S from OPEN, P1 from the guidance's list (key 1 + 10·2 against A's 110),
     // A from the greedy list (guidance 1 against P2's 2), which reaches G: three
     // expansions. ε′ = 101 / min(g + h over OPEN) = 101 / (P2: 2 + 2), above ε = 10,
@@ -172,6 +186,29 @@ fn a_guided_probes_greedy_list_crosses_a_dear_edge_and_reports_its_true_bound() 
     let probe = &r.solutions[0];
     assert_eq!((probe.cost, probe.expansions), (units(101), 42));
     assert!((probe.suboptimality_bound - 1.0).abs() < 1e-12, "{}", probe.suboptimality_bound);
+}
+
+#[test]
+fn a_guided_probes_greedy_list_follows_its_own_estimate() {
+    // The dear edge's probe with its greedy list from the start (3 expansions above),
+    // the greedy list ordered by an estimate of its own: where it puts A behind the
+    // plateau (50 against 2), every list expands the plateau first (S, P1…P40, A: 42);
+    // where the guidance does so and the greedy estimate is the heuristic, the greedy
+    // list takes A third as before.
+    let p = greedy_probe();
+    let behind = |t: &Table| {
+        let mut v = t.h.clone();
+        v[A as usize] = 50;
+        Some(v)
+    };
+    let mut g = dear_edge();
+    g.greedy = behind(&g);
+    let r = arastar(&mut g, S, &p).expect("valid params");
+    assert_eq!((r.solutions[0].cost, r.solutions[0].expansions), (units(101), 42));
+    let mut g = dear_edge();
+    (g.guidance, g.greedy) = (behind(&g), Some(g.h.clone()));
+    let r = arastar(&mut g, S, &p).expect("valid params");
+    assert_eq!((r.solutions[0].path.clone(), r.solutions[0].expansions), (vec![S, A, G], 3));
 }
 
 #[test]
@@ -242,6 +279,7 @@ fn astar_reopens_for_inconsistent_admissible_heuristic() {
         h: vec![0, 0, 12, 0, 0],
         goal: G,
         guidance: None,
+        greedy: None,
     };
     let r = astar(&mut g, S, &SearchParams::default());
     let best = r.best().expect("solution");
@@ -267,6 +305,7 @@ fn unreachable_goal_reports_no_path() {
         h: vec![0; 4],
         goal: G,
         guidance: None,
+        greedy: None,
     };
     let r = astar(&mut g, S, &SearchParams::default());
     assert_eq!(r.termination, Termination::NoPath);
