@@ -339,20 +339,20 @@ impl StepBound {
     /// [`offset_potential`]). Exact integers: c is a whole number of micro-units.
     #[inline]
     pub fn offset_potential(&self, o: &[i8; 4]) -> (Cost, Cost) {
-        let (behind, ahead) = offset_cells(o);
-        let c = self.offset_per_cell.0;
-        (Cost(c.saturating_mul(behind)), Cost(c.saturating_mul(ahead)))
+        offsets_weighed(o, self.offset_per_cell)
     }
 }
 
-/// The cells the feet of offsets `o` stand behind neutral and ahead of it, summed over
-/// the four feet: `(Σ o⁻, Σ o⁺)`.
+/// The feet's offsets `o` (cells) weighed at `per_cell` a cell, as the two parts
+/// `(per_cell · Σ o⁻, per_cell · Σ o⁺)` (o⁻ = max(−o, 0), o⁺ = max(o, 0)): Φ's at c
+/// ([`StepBound::offset_potential`]), the probe's greedy estimate's at its own weight.
 #[inline]
-pub fn offset_cells(o: &[i8; 4]) -> (u64, u64) {
-    o.iter().fold((0, 0), |(behind, ahead), &v| {
+pub fn offsets_weighed(o: &[i8; 4], per_cell: Cost) -> (Cost, Cost) {
+    let (behind, ahead) = o.iter().fold((0u64, 0u64), |(behind, ahead), &v| {
         let cells = u64::from(v.unsigned_abs());
         if v < 0 { (behind + cells, ahead) } else { (behind, ahead + cells) }
-    })
+    });
+    (Cost(per_cell.0.saturating_mul(behind)), Cost(per_cell.0.saturating_mul(ahead)))
 }
 
 /// Which component pairs a step could join at all (criterion 3 over the whole swing).

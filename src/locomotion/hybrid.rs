@@ -157,7 +157,7 @@
 use super::cost_to_go::CostToGo;
 use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, edge_cost};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
-use super::heuristic::{STEP_HEIGHT_TOLERANCE_M, StepBound, StepBoundParams, offset_cells};
+use super::heuristic::{STEP_HEIGHT_TOLERANCE_M, StepBound, StepBoundParams, offsets_weighed};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use super::reachability::{BaseRegions, StanceLimits};
 use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
@@ -491,6 +491,8 @@ pub struct HybridGraph<'c> {
     trig: Vec<(f64, f64)>,
     /// Shortest "front foot forward" move, cells.
     foot_move_cells: i8,
+    /// [`GREEDY_OFFSET_PER_M`] per lattice cell.
+    greedy_offset_per_cell: Cost,
     /// Scratch buffer for the labelled special successors.
     special: Vec<(LatticeState, Cost, Manoeuvre)>,
     /// The counters; a `Cell`, as the step checks are counted in `step_feasible`, which
@@ -707,6 +709,7 @@ impl<'c> HybridGraph<'c> {
             footprints: FootprintTable::new(config.max_footprints),
             trig,
             foot_move_cells,
+            greedy_offset_per_cell: Cost::from_f64(GREEDY_OFFSET_PER_M * res),
             special: Vec::with_capacity(16),
             stats: Cell::new(ManoeuvreStats::default()),
             heuristic: OnceCell::new(),
@@ -872,9 +875,7 @@ impl<'c> HybridGraph<'c> {
         if let Some((o, feet)) = footprint {
             p.steps = tables.step_bound.lower_bound(self.maps, feet);
             (p.behind, p.ahead) = tables.step_bound.offset_potential(o);
-            let per_cell = Cost::from_f64(GREEDY_OFFSET_PER_M * self.lattice.resolution).0;
-            let (behind, ahead) = offset_cells(o);
-            (p.greedy_behind, p.greedy_ahead) = (Cost(per_cell * behind), Cost(per_cell * ahead));
+            (p.greedy_behind, p.greedy_ahead) = offsets_weighed(o, self.greedy_offset_per_cell);
         }
         if p.steps.is_infinite() {
             // No chain of steps reaches the goal: the cost-to-go need not be searched.
