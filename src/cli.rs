@@ -245,11 +245,18 @@ pub struct PlannerArgs {
     /// ramp_detour and ramp_far).
     #[arg(long, allow_negative_numbers = true)]
     pub step_cost_factor: Option<f64>,
-    /// Foot model of the foot cost (default: the scenario's `[params] foot_model`,
-    /// `paper`): `paper`, the paper's disc of radius r_F (eq. 2), or `wheel_pair`, the
-    /// wheel pair's contact footprint at the foot's heading.
+    /// Foot model of the foot cost (default: the scenario's `[params] foot_model`; where
+    /// it names none, `wheel_pair` on terrain with stairs, else `paper`): `paper`, the
+    /// paper's disc of radius r_F (eq. 2), or `wheel_pair`, the wheel pair's contact
+    /// footprint at the foot's heading.
     #[arg(long, value_enum)]
     pub foot_model: Option<FootModelArg>,
+    /// Which manoeuvres prepare steps (default: the scenario's `[params] step_model`, or
+    /// where it names none `stairs` on a flight of four steps or more, else `paper`):
+    /// `paper`, the paper's manoeuvres, or `stairs`, which add those a flight longer than
+    /// the robot needs.
+    #[arg(long, value_enum)]
+    pub step_model: Option<StepModelArg>,
 }
 
 /// `--foot-model` values (`Params::foot_model`).
@@ -260,6 +267,15 @@ pub enum FootModelArg {
     /// The wheel pair's footprint at the foot's heading.
     #[value(name = "wheel_pair", alias = "wheel-pair")]
     WheelPair,
+}
+
+/// `--step-model` values (`Params::step_model`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum StepModelArg {
+    /// The paper's manoeuvres (Sec. V).
+    Paper,
+    /// The paper's and those a flight longer than the robot needs.
+    Stairs,
 }
 
 impl PlannerArgs {
@@ -275,12 +291,18 @@ impl PlannerArgs {
             probe_guidance: !self.unguided_probe,
             schedule_expansions: self.schedule_expansions,
             final_epsilon: self.final_epsilon,
-            k12: self.k12,
-            step_cost_factor: self.step_cost_factor,
-            foot_model: self.foot_model.map(|m| match m {
-                FootModelArg::Paper => crate::params::FootModel::Paper,
-                FootModelArg::WheelPair => crate::params::FootModel::WheelPair,
-            }),
+            overrides: jobs::plan::ParamOverrides {
+                k12: self.k12,
+                step_cost_factor: self.step_cost_factor,
+                foot_model: self.foot_model.map(|m| match m {
+                    FootModelArg::Paper => crate::params::FootModel::Paper,
+                    FootModelArg::WheelPair => crate::params::FootModel::WheelPair,
+                }),
+                step_model: self.step_model.map(|m| match m {
+                    StepModelArg::Paper => crate::params::StepModel::Paper,
+                    StepModelArg::Stairs => crate::params::StepModel::Stairs,
+                }),
+            },
             ..jobs::plan::PlanOptions::default()
         }
     }

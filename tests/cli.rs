@@ -201,7 +201,7 @@ fn bad_planner_option_names_the_parameter() {
 }
 
 #[test]
-fn foot_model_is_checked_in_the_file_and_on_the_command_line() {
+fn models_are_checked_in_the_file_and_on_the_command_line() {
     expect_bad_input(
         "bad_foot_model",
         &format!("{GOOD}\n[params]\nfoot_model = \"wheels\"\n"),
@@ -212,18 +212,22 @@ fn foot_model_is_checked_in_the_file_and_on_the_command_line() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("wheel_pair") && !stderr.contains("panicked"), "{stderr}");
-    let out = momaro(&[
-        "plan",
-        scenario.to_str().unwrap(),
-        "--foot-model",
-        "wheel_pair",
-        "--final-epsilon",
-        "3",
-        "--json",
-    ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
-    assert_eq!(v["foot_model"], "wheel_pair");
+    let out = momaro(&["plan", scenario.to_str().unwrap(), "--step-model", "steps"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("stairs") && !stderr.contains("panicked"), "{stderr}");
+    let plan = |models: &[&str]| {
+        let path = scenario.to_str().unwrap();
+        let args = [&["plan", path, "--final-epsilon", "3", "--json"][..], models].concat();
+        let out = momaro(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+        (v["foot_model"].clone(), v["step_model"].clone())
+    };
+    // Flat ground names no models and has no stairs: the paper's.
+    assert_eq!(plan(&[]), ("paper".into(), "paper".into()));
+    let overridden = plan(&["--foot-model", "wheel_pair", "--step-model", "stairs"]);
+    assert_eq!(overridden, ("wheel_pair".into(), "stairs".into()));
 }
 
 #[test]

@@ -27,7 +27,7 @@ fn every_class_passes_prepare_for_many_seeds() {
         for f in &summary.files {
             let s = Scenario::load(&f.path).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(s.class.as_deref(), Some(class.name()));
-            prepare(&s, &robot, None, None, None)
+            prepare(&s, &robot, Default::default())
                 .unwrap_or_else(|e| panic!("{}: {e}", f.path.display()));
         }
     }

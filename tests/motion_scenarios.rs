@@ -46,7 +46,7 @@ fn expand(
     path: &[PathElement],
 ) -> Result<DetailedPath, MotionError> {
     let robot = sim.robot().clone();
-    let prep = plan::prepare(s, &robot, None, None, None).expect("maps");
+    let prep = plan::prepare(s, &robot, Default::default()).expect("maps");
     let options = MotionOptions::from_params(&prep.params);
     expand_path(path, &robot, &prep.maps, sim, &options)
 }
@@ -174,7 +174,7 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
     // The path up to its first step, with a margin no step can keep, fails at that step,
     // naming it and its leg.
     let robot = sim.robot().clone();
-    let prep = plan::prepare(&s, &robot, None, None, None).expect("maps");
+    let prep = plan::prepare(&s, &robot, Default::default()).expect("maps");
     // 25 cm: the four-wheel postures before it keep more (about 0.3 m), no three-wheel
     // posture can: the support triangles the feet can form have inscribed circles of at
     // most about 0.24 m. (At 15 cm, since the swing clears only what the wheels pass, a
@@ -226,7 +226,7 @@ height = 0.1
     let s = Scenario::parse(text, Path::new("blocked_wheel.toml")).expect("scenario");
     let mut sim = sim();
     let robot = sim.robot().clone();
-    let prep = plan::prepare(&s, &robot, None, None, None).expect("maps");
+    let prep = plan::prepare(&s, &robot, Default::default()).expect("maps");
     let neutral = robot.neutral_footprint();
     let start = PathElement {
         kind: PathKind::Start,

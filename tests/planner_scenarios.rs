@@ -8,10 +8,10 @@
 
 use momaro::geometry::Pose2;
 use momaro::jobs::plan::{
-    self, PathElement, PathKind, PlanJobError, PlanOptions, PlanSummary, run,
+    self, ParamOverrides, PathElement, PathKind, PlanJobError, PlanOptions, PlanSummary, run,
 };
 use momaro::locomotion::Algorithm;
-use momaro::params::StepModel;
+use momaro::params::{FootModel, StepModel};
 use momaro::robot::RobotDescription;
 use momaro::scenario::Scenario;
 use std::path::{Path, PathBuf};
@@ -247,6 +247,27 @@ fn flights_longer_than_the_robot_need_the_stairs_step_model() {
 }
 
 #[test]
+fn stairs_written_without_models_get_the_ones_that_climb_them() {
+    // Building-code flights as a user writes them, naming no models: three steps (the
+    // paper's r_F disc leaves 5 cm of each 0.29 m tread, and the search had no path) and
+    // six (the paper's manoeuvres cannot climb a flight longer than the robot).
+    let probe = PlanOptions { schedule_expansions: Some(0), ..first_solution() };
+    for (name, step_model, climbed) in
+        [("stairs_indoor", StepModel::Paper, 12), ("stairs_long", StepModel::Stairs, 24)]
+    {
+        let path = scenario_path(name);
+        let text = std::fs::read_to_string(&path).expect("scenario");
+        let (head, tail) = text.split_once("[params]").expect("the file names its models");
+        let unnamed = format!("{head}{}", &tail[tail.find("[expect]").expect("expect")..]);
+        let s = Scenario::parse(&unnamed, &path).expect("parses without [params]");
+        assert_eq!((s.params.foot_model, s.params.step_model), (FootModel::WheelPair, step_model));
+        let p = plan(&s, &probe);
+        check_solutions(&p);
+        assert!(steps(&p).len() >= climbed, "{name}: every foot climbs the flight");
+    }
+}
+
+#[test]
 fn a_block_is_climbed_head_on_without_a_detour() {
     // A 0.186 m block across the way, approached square. The paper's base shift ends
     // where a rear leg reaches its full length; here that left the rear legs 0.4 m
@@ -277,7 +298,7 @@ fn orientation_factor_aligns_heading_with_driving_direction() {
             &PlanOptions {
                 algorithm: Algorithm::AStar,
                 time_limit_s: 60.0,
-                k12: Some(k12),
+                overrides: ParamOverrides { k12: Some(k12), ..Default::default() },
                 ..PlanOptions::default()
             },
         )
@@ -324,7 +345,8 @@ fn plans_on_one_prepared_world_share_its_heuristic_and_find_the_same_path() {
         assert_eq!(p.expansions, alone.expansions);
     }
     // A world prepared with other parameters is refused.
-    let other = PlanOptions { k12: Some(1.0), ..opts };
+    let other =
+        PlanOptions { overrides: ParamOverrides { k12: Some(1.0), ..Default::default() }, ..opts };
     assert!(matches!(
         plan::run_on(&prep, &s, &robot, &other),
         Err(PlanJobError::BadOption { option: "prepared", .. })
@@ -362,14 +384,14 @@ fn a_replan_starts_from_the_nearest_pose_a_plan_can_start_from() {
     ));
     let robot = robot();
     assert!(matches!(
-        plan::prepare(&walled, &robot, None, None, None),
+        plan::prepare(&walled, &robot, Default::default()),
         Err(PlanJobError::Untraversable { .. })
     ));
     // The run's world is prepared from a start clear of the wall; the robot then stops
     // at the scenario's start, next to it.
     let mut clear = walled.clone();
     clear.start = Pose2::new(walled.start.x, walled.start.y - 0.3, walled.start.theta);
-    let mut prep = plan::prepare(&clear, &robot, None, None, None).expect("clear of the wall");
+    let mut prep = plan::prepare(&clear, &robot, Default::default()).expect("clear of the wall");
     assert!(matches!(
         prep.set_start(&walled, &robot, walled.start),
         Err(PlanJobError::Untraversable { which: "start", .. })

@@ -61,7 +61,7 @@ pub fn expand(
 }
 
 /// Expands the first `end` elements of `plan`'s path (the whole path for its length), on
-/// the maps the plan was made on (its k12, step cost factor and foot model).
+/// the maps the plan was made on (its k12, step cost factor and models).
 ///
 /// # Errors
 /// [`DetailedJobError`] if the maps cannot be built or the expansion fails.
@@ -71,13 +71,7 @@ pub fn expand_prefix(
     plan: &PlanSummary,
     end: usize,
 ) -> Result<DetailedPath, DetailedJobError> {
-    let prep = plan::prepare(
-        scenario,
-        sim.robot(),
-        Some(plan.k12),
-        Some(plan.step_cost_factor),
-        Some(plan.foot_model),
-    )?;
+    let prep = plan::prepare(scenario, sim.robot(), plan::ParamOverrides::of_plan(plan))?;
     expand_prefix_on(&prep, scenario, sim, plan, end)
 }
 

@@ -128,10 +128,12 @@ pub fn checked_case(
         let text = case.to_toml();
         let path = dir.join(case.file_name());
         match Scenario::parse(&text, &path) {
-            Ok(scenario) => match plan::prepare(&scenario, robot, None, None, None) {
-                Ok(_) => return Ok((case, text)),
-                Err(e) => reason = format!("draw {}: {e}", case.draw),
-            },
+            Ok(scenario) => {
+                match plan::prepare(&scenario, robot, plan::ParamOverrides::default()) {
+                    Ok(_) => return Ok((case, text)),
+                    Err(e) => reason = format!("draw {}: {e}", case.draw),
+                }
+            }
             Err(e) => reason = format!("draw {}: {e}", case.draw),
         }
     }

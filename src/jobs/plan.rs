@@ -36,12 +36,47 @@ use crate::planner::{
     arastar_with_hooks, astar_with_hooks,
 };
 use crate::robot::{Leg, RobotDescription};
-use crate::scenario::{Primitive, Scenario};
+use crate::scenario::{PAPER_MODEL_FLIGHT_STEPS, Primitive, Scenario};
 use crate::terrain::{RasteriseError, rasterise};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
+
+/// What a command line may set over a scenario's `[params]`; `None` keeps the
+/// scenario's value.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ParamOverrides {
+    /// Orientation cost factor k12 (Sec. VII-A); the scenario's default is 2.0.
+    pub k12: Option<f64>,
+    /// Step-related cost factor (`Params::step_cost_factor`).
+    pub step_cost_factor: Option<f64>,
+    /// Foot model of the foot cost (`Params::foot_model`).
+    pub foot_model: Option<FootModel>,
+    /// Which manoeuvres prepare steps (`Params::step_model`).
+    pub step_model: Option<StepModel>,
+}
+
+impl ParamOverrides {
+    /// The overrides that rebuild the maps `plan` was made on.
+    pub fn of_plan(plan: &PlanSummary) -> Self {
+        Self {
+            k12: Some(plan.k12),
+            step_cost_factor: Some(plan.step_cost_factor),
+            foot_model: Some(plan.foot_model),
+            step_model: Some(plan.step_model),
+        }
+    }
+
+    /// `params` with these overrides.
+    fn apply(self, mut params: Params) -> Params {
+        params.k12 = self.k12.unwrap_or(params.k12);
+        params.step_cost_factor = self.step_cost_factor.unwrap_or(params.step_cost_factor);
+        params.foot_model = self.foot_model.unwrap_or(params.foot_model);
+        params.step_model = self.step_model.unwrap_or(params.step_model);
+        params
+    }
+}
 
 /// Options of a plan job.
 #[derive(Debug, Clone, PartialEq)]
@@ -72,12 +107,8 @@ pub struct PlanOptions {
     /// to the initial ε, the first solution is taken: the same plan on any machine, where
     /// a time limit cuts the anytime search wherever the CPU happens to be.
     pub final_epsilon: Option<f64>,
-    /// Orientation cost factor k12 (Sec. VII-A); default the scenario's (2.0).
-    pub k12: Option<f64>,
-    /// Step-related cost factor; default the scenario's (`Params::step_cost_factor`).
-    pub step_cost_factor: Option<f64>,
-    /// Foot model of the foot cost; default the scenario's (`Params::foot_model`).
-    pub foot_model: Option<FootModel>,
+    /// Overrides of the scenario's `[params]` (k12, step-related factor, models).
+    pub overrides: ParamOverrides,
     /// Driving neighbourhood; default N16 for A*, N20 for ARA* (Sec. VII-B).
     pub neighbourhood: Option<Neighbourhood>,
     /// Edges to leave out: manoeuvres the motion generator could not expand in an
@@ -100,9 +131,7 @@ impl Default for PlanOptions {
             schedule_expansions: None,
             max_expansions: None,
             final_epsilon: None,
-            k12: None,
-            step_cost_factor: None,
-            foot_model: None,
+            overrides: ParamOverrides::default(),
             neighbourhood: None,
             forbidden: Vec::new(),
             expansion_image: None,
@@ -330,6 +359,8 @@ pub struct PlanSummary {
     pub step_cost_factor: f64,
     /// The foot model used (`paper` or `wheel_pair`).
     pub foot_model: FootModel,
+    /// The step model used (`paper` or `stairs`).
+    pub step_model: StepModel,
     /// k12 used.
     pub k12: f64,
     /// The grid.
@@ -406,12 +437,10 @@ pub(super) fn bad(option: &'static str, reason: impl Into<String>) -> PlanJobErr
 pub fn prepare(
     scenario: &Scenario,
     robot: &RobotDescription,
-    k12: Option<f64>,
-    step_cost_factor: Option<f64>,
-    foot_model: Option<FootModel>,
+    overrides: ParamOverrides,
 ) -> Result<Prepared, PlanJobError> {
     let t0 = Instant::now();
-    let params = params_for(scenario, k12, step_cost_factor, foot_model)?;
+    let params = params_for(scenario, overrides)?;
     let (maps, lattice) = build_maps(scenario, robot, &params)?;
     let endpoint = |which, pose| endpoint(scenario, robot, &params, (&maps, &lattice), which, pose);
     let start = endpoint("start", scenario.start)?;
@@ -436,7 +465,7 @@ pub fn prepare_for(
     robot: &RobotDescription,
     opts: &PlanOptions,
 ) -> Result<Prepared, PlanJobError> {
-    prepare(scenario, robot, opts.k12, opts.step_cost_factor, opts.foot_model)
+    prepare(scenario, robot, opts.overrides)
 }
 
 /// The lattice state of `scenario`'s `which` pose `pose`, checked: on the map, and one
@@ -465,22 +494,8 @@ fn endpoint(
 }
 
 /// The scenario's parameters with the options' overrides, validated.
-fn params_for(
-    scenario: &Scenario,
-    k12: Option<f64>,
-    step_cost_factor: Option<f64>,
-    foot_model: Option<FootModel>,
-) -> Result<Params, PlanJobError> {
-    let mut params = scenario.params.clone();
-    if let Some(k) = k12 {
-        params.k12 = k;
-    }
-    if let Some(f) = step_cost_factor {
-        params.step_cost_factor = f;
-    }
-    if let Some(m) = foot_model {
-        params.foot_model = m;
-    }
+fn params_for(scenario: &Scenario, overrides: ParamOverrides) -> Result<Params, PlanJobError> {
+    let params = overrides.apply(scenario.params.clone());
     params
         .validate()
         .map_err(|source| PlanJobError::Params { scenario: scenario.path.clone(), source })?;
@@ -740,7 +755,7 @@ pub fn run_on(
     opts: &PlanOptions,
 ) -> Result<PlanSummary, PlanJobError> {
     let limit = check_options(opts)?;
-    let params = params_for(scenario, opts.k12, opts.step_cost_factor, opts.foot_model)?;
+    let params = params_for(scenario, opts.overrides)?;
     if params != prep.params {
         return Err(bad(
             "prepared",
@@ -763,7 +778,7 @@ fn check_options(opts: &PlanOptions) -> Result<Duration, PlanJobError> {
     {
         return Err(bad("probe_epsilon", format!("{e} must be at least 1")));
     }
-    if let Some(k) = opts.k12
+    if let Some(k) = opts.overrides.k12
         && !(k.is_finite() && k >= 1.0)
     {
         return Err(bad("k12", format!("{k} must be at least 1")));
@@ -778,11 +793,6 @@ fn check_options(opts: &PlanOptions) -> Result<Duration, PlanJobError> {
     }
     Ok(limit)
 }
-
-/// Flights of this many steps or more have no path with the paper's step model (README,
-/// "Step model": the feet of one side stay a hip spacing apart, longer than such a
-/// flight's treads allow).
-const PAPER_MODEL_FLIGHT_STEPS: u32 = 4;
 
 /// What a "no path" adds for a scenario planned with the paper's step model whose
 /// terrain has a flight of [`PAPER_MODEL_FLIGHT_STEPS`] or more: the models that climb
@@ -915,6 +925,7 @@ fn search_prepared(
         footprints: graph.footprint_count(),
         step_cost_factor: prep.params.step_cost_factor,
         foot_model: prep.params.foot_model,
+        step_model: prep.params.step_model,
         k12: prep.params.k12,
         map: prep.map_info(),
         keys,
@@ -1096,7 +1107,7 @@ pub fn bench(
         return Err(bad("repeats", "0 must be at least 1"));
     }
     let file = || scenario.path.clone();
-    let prep = prepare(scenario, robot, opts.k12, None, None)?;
+    let prep = prepare(scenario, robot, ParamOverrides { k12: opts.k12, ..Default::default() })?;
     let k12 = prep.params.k12;
     // `tables`: the heuristic cache the graph shares (none: tables of its own), and
     // whether the search stops at its first path.

@@ -89,12 +89,13 @@ impl Class {
         Self::ALL[(i % Self::ALL.len() as u64) as usize]
     }
 
-    /// The step and foot models the class's files ask for in `[params]`, if not the
-    /// paper's: stairs (treads of 0.25–0.40 m, shorter than the robot's 0.7 m hip
-    /// spacing) need the stairs step model, and the wheel pairs' footprint keeps more of
-    /// a tread than the paper's disc (README, "Step model" and "Foot model"), as the
-    /// repository's own stairs scenarios do. (Mixed courses, whose stairs are 2–3 steps
-    /// on 0.30–0.40 m treads, keep the paper's: not measured with them yet.)
+    /// The step and foot models the class's files name in `[params]`, if any: stairs
+    /// (treads of 0.25–0.40 m, shorter than the robot's 0.7 m hip spacing) need the
+    /// stairs step model, and the wheel pairs' footprint keeps more of a tread than the
+    /// paper's disc (README, "Step model" and "Foot model"), as the repository's own
+    /// stairs scenarios do. The other classes name none and get the scenario's defaults
+    /// for their terrain (`scenario::default_models`): mixed courses whose climb is 2–3
+    /// steps get the wheel pair, the rest the paper's models.
     pub fn models(self) -> Option<(StepModel, FootModel)> {
         match self {
             Class::Stairs => Some((StepModel::Stairs, FootModel::WheelPair)),
@@ -1458,8 +1459,12 @@ mod tests {
                     assert_eq!(s.expect.min_stability_margin_m, 0.02);
                 }
                 assert!(s.map.contains(s.start.x, s.start.y) && s.map.contains(s.goal.x, s.goal.y));
-                // Stairs ask for the models that climb treads shorter than the robot.
-                let (step, foot) = class.models().unwrap_or_default();
+                // Stairs ask for the models that climb treads shorter than the robot; the
+                // other classes name none and get the defaults for their terrain.
+                let (step, foot) = class.models().unwrap_or_else(|| {
+                    let (foot, step) = crate::scenario::default_models(&s.terrain);
+                    (step, foot)
+                });
                 assert_eq!((s.params.step_model, s.params.foot_model), (step, foot), "{}", s.name);
                 assert_eq!(class == Class::Stairs, step == StepModel::Stairs);
             }
