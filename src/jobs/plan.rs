@@ -36,7 +36,7 @@ use crate::planner::{
     arastar_with_hooks, astar_with_hooks,
 };
 use crate::robot::{Leg, RobotDescription};
-use crate::scenario::{PAPER_MODEL_FLIGHT_STEPS, Primitive, Scenario};
+use crate::scenario::{PAPER_MODEL_FLIGHT_STEPS, Scenario, longest_flight};
 use crate::terrain::{RasteriseError, rasterise};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -798,15 +798,7 @@ fn check_options(opts: &PlanOptions) -> Result<Duration, PlanJobError> {
 /// terrain has a flight of [`PAPER_MODEL_FLIGHT_STEPS`] or more: the models that climb
 /// it. Empty otherwise.
 fn stairs_model_hint(scenario: &Scenario, step_model: StepModel) -> String {
-    let longest = scenario
-        .terrain
-        .iter()
-        .filter_map(|p| match p {
-            Primitive::Stairs { steps, .. } => Some(*steps),
-            _ => None,
-        })
-        .max();
-    match longest {
+    match longest_flight(&scenario.terrain) {
         Some(n) if step_model == StepModel::Paper && n >= PAPER_MODEL_FLIGHT_STEPS => format!(
             "; its stairs have {n} steps, and with step_model = \"paper\" flights of \
              {PAPER_MODEL_FLIGHT_STEPS} or more have no path: set step_model = \"stairs\" \

@@ -212,18 +212,22 @@ struct NamedModelKeys {
 /// flight of stairs the wheel pair's footprint, and the stairs manoeuvres from a flight of
 /// [`PAPER_MODEL_FLIGHT_STEPS`] steps on; elsewhere the paper's.
 pub fn default_models(terrain: &[Primitive]) -> (FootModel, StepModel) {
-    let longest = terrain
+    match longest_flight(terrain) {
+        None => (FootModel::Paper, StepModel::Paper),
+        Some(n) if n >= PAPER_MODEL_FLIGHT_STEPS => (FootModel::WheelPair, StepModel::Stairs),
+        Some(_) => (FootModel::WheelPair, StepModel::Paper),
+    }
+}
+
+/// The most steps of any `stairs` primitive of `terrain`; `None` without stairs.
+pub fn longest_flight(terrain: &[Primitive]) -> Option<u32> {
+    terrain
         .iter()
         .filter_map(|p| match p {
             Primitive::Stairs { steps, .. } => Some(*steps),
             _ => None,
         })
-        .max();
-    match longest {
-        None => (FootModel::Paper, StepModel::Paper),
-        Some(n) if n >= PAPER_MODEL_FLIGHT_STEPS => (FootModel::WheelPair, StepModel::Stairs),
-        Some(_) => (FootModel::WheelPair, StepModel::Paper),
-    }
+        .max()
 }
 
 /// A loaded, validated scenario.
