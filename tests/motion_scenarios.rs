@@ -11,7 +11,7 @@ mod common;
 
 use momaro::jobs::plan::{self, PathElement, PathKind, PlanOptions, PlanSummary};
 use momaro::locomotion::Algorithm;
-use momaro::motion::{DetailedPath, MotionError, MotionOptions, Phase, expand_path};
+use momaro::motion::{DetailedPath, MotionError, MotionOptions, Phase, ZMP_SHIFT_M, expand_path};
 use momaro::robot::Leg;
 use momaro::scenario::Scenario;
 use momaro::sim::{Simulation, default_model_path};
@@ -51,14 +51,31 @@ fn expand(
     expand_path(path, &robot, &prep.maps, sim, &options)
 }
 
-/// Every keyframe: margin ≥ 3 cm, joints within their ranges, contacts on the ground.
+/// Every keyframe: margin ≥ 3 cm, joints within their ranges, contacts on the ground,
+/// and every standing segment slow enough that its smoothstep's braking (6 d / T² at its
+/// ends, d the CoM's travel) moves the zero-moment point of a CoM h over the feet
+/// (a · h / g) no further than the segment's margin beyond the required one, or
+/// `ZMP_SHIFT_M`.
 fn check(d: &DetailedPath, sim: &Simulation) {
+    let options = MotionOptions::default();
     let robot = sim.robot();
     assert!(d.min_margin_m >= 0.03, "min margin {:.3}", d.min_margin_m);
     assert!(d.min_keyframe_margin_m >= 0.03);
     let mut t = -1.0;
-    for k in &d.keyframes {
+    for (n, k) in d.keyframes.iter().enumerate() {
         assert!(k.time_s > t || k.phase == Phase::Start, "time order");
+        if let Some(a) = n.checked_sub(1).map(|m| &d.keyframes[m])
+            && !matches!(k.phase, Phase::Drive | Phase::Start)
+        {
+            let travel = (k.com[0] - a.com[0]).hypot(k.com[1] - a.com[1]);
+            let feet: Vec<f64> = (0..4).filter(|&i| k.contact[i]).map(|i| k.feet[i][2]).collect();
+            let h = k.com[2] - feet.iter().sum::<f64>() / feet.len() as f64;
+            let span = k.time_s - a.time_s;
+            let shift = 6.0 * travel / (span * span) * h / 9.81;
+            let spare = k.segment_min_margin_m - options.required_margin(&k.posture());
+            let allowed = spare.max(ZMP_SHIFT_M);
+            assert!(shift <= allowed + 1e-9, "{:?} at {n}: {shift:.4} m of {allowed:.4}", k.phase);
+        }
         t = k.time_s;
         assert!(k.segment_min_margin_m >= 0.03, "{:?} at {}", k.phase, k.path_index);
         for leg in Leg::ALL {

@@ -120,6 +120,10 @@ pub struct MotionOptions {
     pub foot_speed: f64,
     /// Roll, pitch and yaw rate for timing, rad/s.
     pub angular_speed: f64,
+    /// Largest shift of the zero-moment point from the CoM's ground projection that a
+    /// standing segment's own acceleration may cause where its margin has none to spare,
+    /// m; elsewhere the margin beyond the required one (see [`Expander::duration`]).
+    pub zmp_shift_m: f64,
 }
 
 impl MotionOptions {
@@ -142,6 +146,7 @@ impl MotionOptions {
             wheel_speed: 0.1,
             foot_speed: 0.1,
             angular_speed: 0.2,
+            zmp_shift_m: ZMP_SHIFT_M,
         }
     }
 
@@ -257,6 +262,11 @@ struct Expander<'a> {
     o: &'a MotionOptions,
     keys: Vec<Keyframe>,
     cur: Posture,
+    /// The CoM estimate of `cur`, once known (segment timing, [`Expander::duration`]).
+    cur_com: Option<[f64; 3]>,
+    /// Whether keyframes are timed for braking ([`Expander::duration`]): not for the
+    /// planner's checks ([`ManoeuvreCheck`]), which keep no keyframes.
+    braking: bool,
     time: f64,
     samples: usize,
     min_margin: f64,
@@ -283,6 +293,8 @@ impl<'a> Expander<'a> {
             o,
             keys: Vec::new(),
             cur,
+            cur_com: None,
+            braking: true,
             time: 0.0,
             samples: 0,
             min_margin: f64::INFINITY,
@@ -445,7 +457,29 @@ impl<'a> Expander<'a> {
         Ok(SegmentCheck { end, min_margin, min_three, samples: n })
     }
 
-    fn duration(&self, a: &Posture, b: &Posture) -> f64 {
+    /// How long the executor takes from `a` to `b`, whose CoM estimates are `coms`: the
+    /// base and feet at their speeds, the base's angles at theirs, and slow enough for
+    /// the CoM's own acceleration (not for a drive, which the path follower times, nor in
+    /// the planner's checks, which keep no keyframes). `spare` is how far the segment's
+    /// smallest margin exceeds what its end posture must keep.
+    ///
+    /// The executor moves along a smoothstep (`control::step_executor::smoothstep`), so
+    /// a CoM moved by `d` in time `T` accelerates at up to `6 d / T²` at both ends, and its
+    /// zero-moment point then lies `a · h / g` from its ground projection (`h` its height
+    /// over the feet in contact): the static margin the checks ask is not what holds while
+    /// it brakes. At the wheel speed a 4 cm shift of a CoM 0.5 m up took 0.4 s and moved
+    /// the zero-moment point 8 cm; braking the descent shift on a generated flight
+    /// (stairs seed 20008, 3-7 cm of static margin over the lower front pairs) unloaded
+    /// both rear pairs at every keyframe. `T ≥ √(6 d h / (g δ))` keeps the shift within
+    /// `δ`: the margin to spare, and never less than `MotionOptions::zmp_shift_m`, which
+    /// the required margin then pays.
+    fn duration(
+        &self,
+        (a, b): (&Posture, &Posture),
+        coms: [[f64; 3]; 2],
+        spare: f64,
+        drive: bool,
+    ) -> f64 {
         let o = self.o;
         let d2 = |p: [f64; 3], q: [f64; 3]| (p[0] - q[0]).hypot(p[1] - q[1]).hypot(p[2] - q[2]);
         let base = d2(a.base_position, b.base_position) / o.wheel_speed;
@@ -453,7 +487,12 @@ impl<'a> Expander<'a> {
         let ang =
             (0..3).map(|k| wrap_angle(b.base_rpy[k] - a.base_rpy[k]).abs()).fold(0.0, f64::max)
                 / o.angular_speed;
-        base.max(feet).max(ang).max(0.1)
+        let braking = if drive || !self.braking {
+            0.0
+        } else {
+            zmp_duration(b, coms, spare.max(o.zmp_shift_m))
+        };
+        base.max(feet).max(ang).max(braking).max(0.1)
     }
 
     /// Checks a sequence from the current posture without committing it; returns the
@@ -473,15 +512,30 @@ impl<'a> Expander<'a> {
             })?;
         }
         let mut from = self.cur;
+        // The CoM the first segment starts from, estimated once per posture stood in (a
+        // committed keyframe brings its own); none where keyframes are not timed.
+        let mut from_com = match self.cur_com {
+            Some(c) => c,
+            None if !self.braking => [f64::NAN; 3],
+            None => {
+                let c = self.com_of(&from).unwrap_or([f64::NAN; 3]);
+                self.cur_com = Some(c);
+                c
+            }
+        };
         let mut t = self.time;
         let mut out = Vec::with_capacity(seq.len());
         let (mut mm, mut m3, mut samples) = (f64::INFINITY, f64::INFINITY, 0);
         for &(phase, leg, p) in seq {
-            let c =
-                self.check_segment(&from, &p, phase == Phase::Drive).map_err(|(t, cause)| {
-                    SegmentFailure { phase: phase.name(), percent: t * 100.0, cause }
-                })?;
-            t += self.duration(&from, &p);
+            let drive = phase == Phase::Drive;
+            let c = self.check_segment(&from, &p, drive).map_err(|(t, cause)| SegmentFailure {
+                phase: phase.name(),
+                percent: t * 100.0,
+                cause,
+            })?;
+            let spare = c.min_margin - self.o.required_margin(&p);
+            t += self.duration((&from, &p), [from_com, c.end.com], spare, drive);
+            from_com = c.end.com;
             mm = mm.min(c.min_margin);
             m3 = m3.min(c.min_three);
             samples += c.samples;
@@ -509,6 +563,7 @@ impl<'a> Expander<'a> {
     fn commit(&mut self, keys: Vec<Keyframe>, mm: f64, m3: f64, samples: usize) {
         if let Some(k) = keys.last() {
             self.cur = k.posture();
+            self.cur_com = Some(k.com);
             self.time = k.time_s;
         }
         self.min_margin = self.min_margin.min(mm);
@@ -1092,7 +1147,8 @@ pub struct ManoeuvreCheck<'a> {
 
 impl ManoeuvreCheck<'_> {
     fn expander(&mut self, pre: Posture) -> Expander<'_> {
-        Expander::at(self.robot, self.maps, &mut *self.model, self.options, pre)
+        let e = Expander::at(self.robot, self.maps, &mut *self.model, self.options, pre);
+        Expander { braking: false, ..e }
     }
 
     /// A step: whether the expansion finds a stable motion among the
@@ -1388,6 +1444,28 @@ pub fn expand_path(
     })
 }
 
+/// Default of [`MotionOptions::zmp_shift_m`]: where a segment has no margin to spare, a
+/// third of the 3 cm the checks ask on four feet, so that braking at its ends keeps its
+/// zero-moment point at least 2 cm inside the support (`Expander::duration`).
+pub const ZMP_SHIFT_M: f64 = 0.01;
+
+/// Standard gravity, m/s².
+const GRAVITY: f64 = 9.81;
+
+/// The shortest smoothstep time for a CoM moving from `coms[0]` to `coms[1]` whose
+/// zero-moment point stays within `shift` of its ground projection: `√(6 d h / (g δ))`
+/// with `d` the CoM's horizontal travel and `h` its height over the mean of the feet `b`
+/// has in contact (`Expander::duration`). Zero where a CoM is unknown.
+fn zmp_duration(b: &Posture, coms: [[f64; 3]; 2], shift: f64) -> f64 {
+    let [c0, c1] = coms;
+    let d = (c1[0] - c0[0]).hypot(c1[1] - c0[1]);
+    let (sum, n) =
+        (0..4).filter(|&i| b.contact[i]).fold((0.0, 0.0), |(s, n), i| (s + b.feet[i][2], n + 1.0));
+    let h = if n > 0.0 { c1[2] - sum / n } else { 0.0 };
+    let t = (6.0 * d * h.max(0.0) / (GRAVITY * shift)).sqrt();
+    if t.is_finite() { t } else { 0.0 }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1408,5 +1486,31 @@ mod tests {
         assert!((o.required_margin(&p) - 0.05).abs() < 1e-12);
         let low = MotionOptions { min_three_contact_margin_m: 0.01, ..o };
         assert!((low.required_margin(&p) - 0.03).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_segment_is_slow_enough_for_its_zero_moment_point() {
+        // A CoM 0.5 m over the feet moved 5 cm (3 cm, 4 cm): 6 · 0.05 · 0.5 / (9.81 · 0.01)
+        // = 1.529052 s², T = 1.236548 s; the smoothstep's peak acceleration 6 d / T² then
+        // moves the zero-moment point a · h / g = 1 cm.
+        let mut b = Posture {
+            base_position: [0.0, 0.0, 0.6],
+            base_rpy: [0.0; 3],
+            feet: [[0.0, 0.0, 0.1]; 4],
+            contact: [true; 4],
+        };
+        let coms = [[0.0, 0.0, 0.6], [0.03, 0.04, 0.6]];
+        let t = zmp_duration(&b, coms, 0.01);
+        assert!((t - 1.236_548).abs() < 1e-6, "{t}");
+        assert!((6.0 * 0.05 / (t * t) * 0.5 / GRAVITY - 0.01).abs() < 1e-9);
+        // Four times the shift (a segment with 4 cm of margin to spare): half the time.
+        assert!((zmp_duration(&b, coms, 0.04) - t / 2.0).abs() < 1e-12);
+        // The height counts over the feet in contact only; a CoM that does not move, or an
+        // unknown one, asks nothing.
+        b.feet[3][2] = 0.5;
+        b.contact[3] = false;
+        assert!((zmp_duration(&b, coms, 0.01) - t).abs() < 1e-12);
+        assert_eq!(zmp_duration(&b, [coms[1]; 2], 0.01), 0.0);
+        assert_eq!(zmp_duration(&b, [[f64::NAN; 3], coms[1]], 0.01), 0.0);
     }
 }

@@ -20,7 +20,7 @@ pub mod kinematics;
 pub mod roll;
 pub mod standing;
 
-pub use expand::{MotionError, MotionOptions, expand_path};
+pub use expand::{MotionError, MotionOptions, ZMP_SHIFT_M, expand_path};
 pub use keyframe::{DetailedPath, Keyframe, Phase};
 pub use kinematics::{Evaluation, Posture, rotation};
 pub use roll::{RollError, RollSolution, roll_for_lateral_com};
