@@ -229,8 +229,22 @@ impl HeightMap {
     /// The cell containing world point (x, y), or `None` outside the map (or for NaN).
     #[inline]
     pub fn cell_of(&self, x: f64, y: f64) -> Option<(usize, usize)> {
-        let fx = (x - self.origin[0]) / self.resolution;
-        let fy = (y - self.origin[1]) / self.resolution;
+        self.cell_at_grid(self.grid_coords(x, y))
+    }
+
+    /// World point (x, y) in grid units: cell (i, j) spans `[i, i + 1) × [j, j + 1)`.
+    /// Points along a straight line in the world lie along one here too, so a caller
+    /// sampling a segment converts its ends and interpolates, instead of dividing at
+    /// every sample ([`Self::height_at_grid`]).
+    #[inline]
+    pub fn grid_coords(&self, x: f64, y: f64) -> [f64; 2] {
+        [(x - self.origin[0]) / self.resolution, (y - self.origin[1]) / self.resolution]
+    }
+
+    /// The cell at grid coordinates `g` ([`Self::grid_coords`]), or `None` outside the
+    /// map (or for NaN).
+    #[inline]
+    fn cell_at_grid(&self, [fx, fy]: [f64; 2]) -> Option<(usize, usize)> {
         // The comparisons are false for NaN, so NaN input yields None. On [0, n) the
         // truncating cast is floor (and cheaper: no libm call on baseline x86-64).
         if fx >= 0.0 && fy >= 0.0 && fx < self.nx as f64 && fy < self.ny as f64 {
@@ -238,6 +252,14 @@ impl HeightMap {
         } else {
             None
         }
+    }
+
+    /// Height of the cell at grid coordinates `g` ([`Self::grid_coords`]): `None` if
+    /// unknown or outside the map.
+    #[inline]
+    pub fn height_at_grid(&self, g: [f64; 2]) -> Option<f64> {
+        let (i, j) = self.cell_at_grid(g)?;
+        self.get(i, j)
     }
 
     /// World position of the centre of cell (i, j), m. Defined for any index, also
@@ -812,6 +834,14 @@ mod tests {
         assert_eq!(m.get(4, 0), None);
         assert_eq!(m.height_at_cell(0.3, 3.2), Some(22.0));
         assert_eq!(m.bounds(), [-1.0, 2.0, 1.0, 3.5]);
+        // Grid units: origin (-1, 2), 0.5 m cells; (0.3, 3.2) is 2.6 and 2.4 cells in.
+        let g = m.grid_coords(0.3, 3.2);
+        assert!((g[0] - 2.6).abs() < 1e-12 && (g[1] - 2.4).abs() < 1e-12, "{g:?}");
+        assert_eq!(m.height_at_grid(g), Some(22.0));
+        assert_eq!(m.height_at_grid([2.0, 0.0]), Some(2.0), "a cell's corner is its own");
+        assert_eq!(m.height_at_grid([4.0, 0.0]), None, "nx is outside");
+        assert_eq!(m.height_at_grid([-1e-9, 0.0]), None);
+        assert_eq!(m.height_at_grid([f64::NAN, 0.0]), None);
     }
 
     #[test]
