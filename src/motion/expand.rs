@@ -262,8 +262,6 @@ struct Expander<'a> {
     o: &'a MotionOptions,
     keys: Vec<Keyframe>,
     cur: Posture,
-    /// The CoM estimate of `cur`, once known (segment timing, [`Expander::duration`]).
-    cur_com: Option<[f64; 3]>,
     /// Whether keyframes are timed for braking ([`Expander::duration`]): not for the
     /// planner's checks ([`ManoeuvreCheck`]), which keep no keyframes.
     braking: bool,
@@ -293,7 +291,6 @@ impl<'a> Expander<'a> {
             o,
             keys: Vec::new(),
             cur,
-            cur_com: None,
             braking: true,
             time: 0.0,
             samples: 0,
@@ -512,16 +509,11 @@ impl<'a> Expander<'a> {
             })?;
         }
         let mut from = self.cur;
-        // The CoM the first segment starts from, estimated once per posture stood in (a
-        // committed keyframe brings its own); none where keyframes are not timed.
-        let mut from_com = match self.cur_com {
-            Some(c) => c,
-            None if !self.braking => [f64::NAN; 3],
-            None => {
-                let c = self.com_of(&from).unwrap_or([f64::NAN; 3]);
-                self.cur_com = Some(c);
-                c
-            }
+        // The CoM the first segment starts from: the last keyframe's, the posture stood in
+        // (from the start keyframe on); none where keyframes are not timed.
+        let mut from_com = match self.keys.last() {
+            Some(k) if self.braking => k.com,
+            _ => [f64::NAN; 3],
         };
         let mut t = self.time;
         let mut out = Vec::with_capacity(seq.len());
@@ -563,7 +555,6 @@ impl<'a> Expander<'a> {
     fn commit(&mut self, keys: Vec<Keyframe>, mm: f64, m3: f64, samples: usize) {
         if let Some(k) = keys.last() {
             self.cur = k.posture();
-            self.cur_com = Some(k.com);
             self.time = k.time_s;
         }
         self.min_margin = self.min_margin.min(mm);
