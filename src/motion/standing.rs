@@ -130,12 +130,10 @@ impl StandingRule {
             let i = leg.index();
             let h = robot.hips[i];
             let LegChain { knee, ankle, .. } = legs.chains[i];
-            // The chain's points in the world: the base transform is affine, so the
-            // samples between them are the world points' interpolation (three
-            // transforms a leg, not eight).
-            // And in the terrain's grid units (x, y; z stays in metres), affine in the
-            // world's too: three divisions a leg, not eight (this check was a fifth of
-            // the platform's A* time; its optimum came 1-5 % sooner, the same search).
+            // The chain's points in the terrain's grid units (x, y; z in metres): the base
+            // transform and the grid's are affine, so the samples between the points are
+            // their interpolation (three transforms and divisions a leg, not eight; this
+            // check was a fifth of the platform's A* time, its optimum 1-5 % sooner).
             let chain = [
                 [h[0], h[1], h[2]],
                 [h[0] + knee[0], h[1], h[2] + knee[1]],
