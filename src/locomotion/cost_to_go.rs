@@ -284,10 +284,17 @@ impl CostToGo {
 
     /// `P` of a node (computed on first use): the smallest driving pose cost over its
     /// orientation group, raised to 1, less the cache slack; +∞ if none is finite.
+    #[inline]
     fn pose_bound(&self, search: &mut Search, maps: &CostMaps, node: usize) -> f64 {
         if let Some(v) = search.nodes[node].pose() {
             return f64::from(v);
         }
+        self.compute_pose_bound(search, maps, node)
+    }
+
+    /// [`Self::pose_bound`] of a node not yet computed.
+    #[inline(never)]
+    fn compute_pose_bound(&self, search: &mut Search, maps: &CostMaps, node: usize) -> f64 {
         let nx = usize::from(self.lattice.nx);
         let cells = self.cells();
         let cell = node % cells;
@@ -362,10 +369,11 @@ impl CostToGo {
                 if a < 0 || b < 0 || a >= nx || b >= ny {
                     continue;
                 }
+                // A settled neighbour needs no test of its own: its distance is below
+                // d + w (d lies in the bucket being taken and w is no lighter than a
+                // bucket is wide), so `relax` leaves it (the test was an unpredictable
+                // branch per edge; the cold search 5 % sooner without it).
                 let n = node_at(a, b);
-                if search.nodes[n].done() {
-                    continue;
-                }
                 let pa = self.pose_bound(search, maps, n);
                 if pa.is_finite() {
                     let w = self.move_weight[row + k] * 0.5 * (pa + pc);
@@ -377,9 +385,6 @@ impl CostToGo {
             if layers > 1 {
                 for t2 in [(t + 1) % layers, (t + layers - 1) % layers] {
                     let n = t2 * cells + cell;
-                    if search.nodes[n].done() {
-                        continue;
-                    }
                     let pa = self.pose_bound(search, maps, n);
                     if pa.is_finite() {
                         let w = self.turn_length * 0.5 * (pa + pc);
@@ -394,10 +399,13 @@ impl CostToGo {
         }
     }
 
+    /// Lowers node `n`'s tentative distance to `d` and queues it, if `d` is lower. Never
+    /// reopens a settled node: `d` (a distance of the bucket being taken plus an edge) is
+    /// above every settled distance.
     #[inline]
     fn relax(search: &mut Search, n: usize, d: Cost) {
         let record = &mut search.nodes[n];
-        if !record.done() && d < record.dist() {
+        if d < record.dist() {
             record.set_dist(d);
             search.queue.push(d, n as u32);
         }
@@ -668,6 +676,106 @@ mod tests {
         }
         assert_eq!(layer_of(0, 64, 1), 0);
         assert_eq!(members(0, 64, 64).count(), 64);
+    }
+
+    /// Dijkstra's distances over the relaxed graph of `ctg` (the same in-edges as
+    /// `run_until`), with a binary heap and no pruning: the reference the bucket queue and
+    /// its shortcuts must reproduce.
+    fn reference_distances(ctg: &CostToGo, maps: &CostMaps, root: usize) -> Vec<Cost> {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
+        let (layers, cells) = (ctg.layers, ctg.cells());
+        let (nx, ny) = (i32::from(ctg.lattice.nx), i32::from(ctg.lattice.ny));
+        let mut poses = Search::new(layers * cells, Buckets::new(Cost(1)), &[]);
+        poses.stencils = (0..ctg.lattice.orientations)
+            .map(|k| maps.driving_stencil(ctg.lattice.yaw(k as u8)))
+            .collect();
+        let mut dist = vec![Cost::INFINITY; layers * cells];
+        let mut heap = BinaryHeap::from([Reverse((Cost::ZERO, root))]);
+        dist[root] = Cost::ZERO;
+        while let Some(Reverse((d, c))) = heap.pop() {
+            if d > dist[c] {
+                continue;
+            }
+            let (t, cell) = (c / cells, c % cells);
+            let (ci, cj) = ((cell % nx as usize) as i32, (cell / nx as usize) as i32);
+            let mut edges: Vec<(usize, Cost)> = Vec::new();
+            let inside = |a: i32, b: i32| a >= 0 && b >= 0 && a < nx && b < ny;
+            for &(di, dj) in &ctg.shift_links[t] {
+                if inside(ci - di, cj - dj) {
+                    edges.push((t * cells + ((cj - dj) * nx + ci - di) as usize, ctg.shift_step));
+                }
+            }
+            let pc = ctg.pose_bound(&mut poses, maps, c);
+            if pc.is_finite() {
+                let mut neighbours: Vec<(usize, f64)> = Vec::new();
+                for (k, &(di, dj)) in ctg.moves.iter().enumerate() {
+                    if inside(ci - di, cj - dj) {
+                        let n = t * cells + ((cj - dj) * nx + ci - di) as usize;
+                        neighbours.push((n, ctg.move_weight[t * ctg.moves.len() + k]));
+                    }
+                }
+                if layers > 1 {
+                    for t2 in [(t + 1) % layers, (t + layers - 1) % layers] {
+                        neighbours.push((t2 * cells + cell, ctg.turn_length));
+                    }
+                }
+                for (n, length) in neighbours {
+                    let pa = ctg.pose_bound(&mut poses, maps, n);
+                    if pa.is_finite() {
+                        let w =
+                            Cost::from_f64_floor(length * 0.5 * (pa + pc) * (1.0 - WEIGHT_SLACK));
+                        edges.push((n, w));
+                    }
+                }
+            }
+            for (n, w) in edges {
+                let nd = d.saturating_add(w);
+                if nd < dist[n] {
+                    dist[n] = nd;
+                    heap.push(Reverse((nd, n)));
+                }
+            }
+        }
+        dist
+    }
+
+    #[test]
+    fn the_bucket_queue_settles_dijkstras_distances() {
+        // Every fourth orientation of every cell against the reference, queried in a
+        // scattered order (each query resumes the lazy search where the last stopped).
+        let (maps, lattice, driving) = setup();
+        let goal = GOAL;
+        for groups in [64, 8, 1] {
+            let ctg = CostToGo::new(
+                lattice,
+                &driving,
+                Cost::from_f64_floor(0.3),
+                goal,
+                (groups, usize::MAX),
+            );
+            let (gi, gj, _) = goal;
+            let root = layer_of(0, ctg.group, ctg.layers) * ctg.cells()
+                + gj as usize * usize::from(lattice.nx)
+                + gi as usize;
+            let want = reference_distances(&ctg, &maps, root);
+            let (nx, ny) = (i16::try_from(lattice.nx).unwrap(), i16::try_from(lattice.ny).unwrap());
+            let mut finite = 0;
+            // A scattered order of orientations and rows (every fourth orientation).
+            for t in (0..16u8).map(|k| (u32::from(k) * 28 % 64) as u8) {
+                for j in (0..ny).map(|k| k * 5 % ny) {
+                    for i in 0..nx {
+                        let node = layer_of(usize::from(t), ctg.group, ctg.layers) * ctg.cells()
+                            + j as usize * usize::from(lattice.nx)
+                            + i as usize;
+                        let got = ctg.get(&maps, i, j, t);
+                        assert_eq!(got, want[node], "{groups} groups at ({i}, {j}, {t})");
+                        finite += usize::from(!got.is_infinite());
+                    }
+                }
+            }
+            assert!(finite > 1000, "{groups} groups: {finite} finite");
+        }
     }
 
     #[test]

@@ -21,14 +21,20 @@ pub const MAX_LATERAL_MISMATCH_M: f64 = 0.03;
 
 /// Rotation matrix of roll, pitch, yaw (ZYX: R = Rz(yaw)·Ry(pitch)·Rx(roll)), row-major.
 pub fn rotation(rpy: [f64; 3]) -> [[f64; 3]; 3] {
-    let (sr, cr) = rpy[0].sin_cos();
-    let (sp, cp) = rpy[1].sin_cos();
-    let (sy, cy) = rpy[2].sin_cos();
+    let [(sr, cr), (sp, cp), (sy, cy)] = rpy.map(sin_cos);
     [
         [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
         [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
         [-sp, cp * sr, cp * cr],
     ]
+}
+
+/// `a.sin_cos()`, without libm's call at zero (the same values, ±0 and 1): the standing
+/// rule rotates a base without roll, and without pitch on level ground, for every
+/// footprint the planner stands.
+#[inline]
+fn sin_cos(a: f64) -> (f64, f64) {
+    if a == 0.0 { (a, 1.0) } else { a.sin_cos() }
 }
 
 /// `position + r · p`.
@@ -325,7 +331,14 @@ pub fn pitch_from_feet(feet: &[[f64; 3]; 4], yaw: f64, pitch_fraction: f64) -> f
     let along = |f: [f64; 3]| c * f[0] + s * f[1];
     let dx = (along(feet[0]) + along(feet[1]) - along(feet[2]) - along(feet[3])) / 2.0;
     let dz = (feet[0][2] + feet[1][2] - feet[2][2] - feet[3][2]) / 2.0;
-    let slope = if dx.abs() > 1e-6 { (dz / dx).atan() } else { 0.0 };
+    // (atan(±0) is ±0: level feet need no libm call.)
+    let slope = if dx.abs() <= 1e-6 {
+        0.0
+    } else if dz == 0.0 {
+        dz / dx
+    } else {
+        (dz / dx).atan()
+    };
     -pitch_fraction * slope
 }
 
@@ -398,6 +411,28 @@ pub fn interpolate(a: &Posture, b: &Posture, t: f64) -> Posture {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn level_shortcuts_give_libms_bits() {
+        // `sin_cos` skips libm at ±0 only, with its values to the bit.
+        for a in [0.0, -0.0, 1e-300, -0.3, 2.0] {
+            let (s, c) = sin_cos(a);
+            let (ls, lc) = a.sin_cos();
+            assert_eq!((s.to_bits(), c.to_bits()), (ls.to_bits(), lc.to_bits()), "{a}");
+        }
+        // Level feet: the pitch of the arctangent of a zero slope, its sign included.
+        let feet = [[0.3, 0.2, 0.1], [0.3, -0.2, 0.1], [-0.4, 0.2, 0.1], [-0.4, -0.2, 0.1]];
+        for yaw in [0.0_f64, 3.0] {
+            let dx = yaw.cos() * 0.7;
+            let want = -0.7 * (0.0_f64 / dx).atan();
+            assert_eq!(pitch_from_feet(&feet, yaw, 0.7).to_bits(), want.to_bits(), "{yaw}");
+        }
+        // A slope still takes the arctangent.
+        let mut up = feet;
+        up[0][2] = 0.2;
+        up[1][2] = 0.2;
+        assert!((pitch_from_feet(&up, 0.0, 0.7) + 0.7 * (0.1f64 / 0.7).atan()).abs() < 1e-15);
+    }
 
     #[test]
     fn a_level_pair_stands_on_both_wheels_a_rolled_one_on_its_lower_wheel() {
