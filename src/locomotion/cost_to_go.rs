@@ -745,16 +745,15 @@ mod tests {
         // Every fourth orientation of every cell against the reference, queried in a
         // scattered order (each query resumes the lazy search where the last stopped).
         let (maps, lattice, driving) = setup();
-        let goal = GOAL;
         for groups in [64, 8, 1] {
             let ctg = CostToGo::new(
                 lattice,
                 &driving,
                 Cost::from_f64_floor(0.3),
-                goal,
+                GOAL,
                 (groups, usize::MAX),
             );
-            let (gi, gj, _) = goal;
+            let (gi, gj, _) = GOAL;
             let root = layer_of(0, ctg.group, ctg.layers) * ctg.cells()
                 + gj as usize * usize::from(lattice.nx)
                 + gi as usize;
