@@ -89,7 +89,7 @@ const POSE_SLACK: f64 = 1e-6;
 /// Relative slack on relaxed edge weights (edges are rounded up with 10⁻¹²).
 const WEIGHT_SLACK: f64 = 1e-9;
 /// Default for the most (cell, group) nodes searched with more than one orientation
-/// group (16 bytes each: 128 MB at the limit, a 9 m × 9 m map with 64 groups); larger
+/// group (8 bytes each: 64 MB at the limit, a 9 m × 9 m map with 64 groups); larger
 /// maps get one group, the minimum over all orientations.
 pub const MAX_ORIENTED_NODES: usize = 1 << 23;
 /// Default orientation groups of the cost-to-go (see the module docs): one per
@@ -136,12 +136,16 @@ struct Search {
     stencils: Vec<Option<DrivingStencil>>,
     /// Per node (`layer · cells + cell`, cells row-major `j · nx + i`: a layer's cells
     /// lie together, as drive edges join them), its record: see [`NodeRecord`].
-    nodes: Vec<u128>,
+    nodes: Vec<u64>,
     queue: Buckets,
     /// Nodes settled so far.
     settled: usize,
     /// Set when the deadline passed: a lower bound on `D` of every unsettled node.
     frozen: Option<Cost>,
+    /// Distances from this on are not kept ([`MAX_DIST`]; lower in tests).
+    cap: Cost,
+    /// Whether a relaxation reached `cap` (see [`CostToGo::relax`]).
+    capped: bool,
 }
 
 impl CostToGo {
@@ -244,8 +248,10 @@ impl CostToGo {
         if search.nodes[node].done() {
             search.nodes[node].dist()
         } else {
-            // Frozen: the frontier's bound; else the queue ran empty: no path at all.
-            search.frozen.unwrap_or(Cost::INFINITY)
+            // Frozen: the frontier's bound; else the queue ran empty: past the distances
+            // a record keeps (`min(D, MAX_DIST)`, consistent like the frozen bound), or
+            // no path at all.
+            search.frozen.unwrap_or(if search.capped { search.cap } else { Cost::INFINITY })
         }
     }
 
@@ -340,6 +346,9 @@ impl CostToGo {
             // The next entry; stale ones (the node was settled, or queued again lower)
             // are skipped.
             let Some(c) = search.queue.pop() else { return };
+            if let Some(f) = search.queue.ahead(PREFETCH_AHEAD) {
+                prefetch_neighbourhood(&search.nodes, f as usize, nx as usize, cells);
+            }
             let c = c as usize;
             let d = search.nodes[c].dist();
             if search.nodes[c].done() || !search.queue.holds(d) {
@@ -401,11 +410,17 @@ impl CostToGo {
 
     /// Lowers node `n`'s tentative distance to `d` and queues it, if `d` is lower. Never
     /// reopens a settled node: `d` (a distance of the bucket being taken plus an edge) is
-    /// above every settled distance.
+    /// above every settled distance. A `d` from [`MAX_DIST`] on is not kept but marks the
+    /// search capped: once its queue runs empty, every node it did not settle lies at
+    /// least `MAX_DIST` away (or has no path), and gets that bound (see [`Self::get`]).
     #[inline]
     fn relax(search: &mut Search, n: usize, d: Cost) {
         let record = &mut search.nodes[n];
         if d < record.dist() {
+            if d >= search.cap {
+                search.capped = true;
+                return;
+            }
             record.set_dist(d);
             search.queue.push(d, n as u32);
         }
@@ -415,12 +430,20 @@ impl CostToGo {
 impl Search {
     /// A search with `roots` at distance 0.
     fn new(n: usize, mut queue: Buckets, roots: &[usize]) -> Self {
-        let mut nodes = vec![0u128; n];
+        let mut nodes = vec![0u64; n];
         for &r in roots {
             nodes[r].set_dist(Cost::ZERO);
             queue.push(Cost::ZERO, r as u32);
         }
-        Self { stencils: Vec::new(), nodes, queue, settled: 0, frozen: None }
+        Self {
+            stencils: Vec::new(),
+            nodes,
+            queue,
+            settled: 0,
+            frozen: None,
+            cap: MAX_DIST,
+            capped: false,
+        }
     }
 
     /// Stops the search: every node not settled is at least as far as the current
@@ -437,29 +460,41 @@ impl Search {
     }
 }
 
-/// A node's search state in 16 bytes, one cache line with its neighbours' in the same
-/// row of its layer (three arrays took three cache misses per touched node):
-/// bits 0–63 the tentative distance plus one (0: none yet), bits 64–95 `P` as `f32` bits
-/// (0.0: not computed yet; `P ≥ 1` otherwise, so 0 is never a value), bit 96 settled.
-/// All-zero when untouched, so `vec![0u128; n]` is a zeroed allocation the system hands
-/// out lazily: pages are touched only where the search goes.
+/// A node's search state in 8 bytes, eight to a cache line, so that the 20 drive
+/// neighbours of a node (five rows of five cells of its layer) take one or two lines a
+/// row (three arrays took three cache misses per touched node, 16-byte records two lines
+/// a row: the records' loads are most of the search's time): bits 0–31 the tentative
+/// distance plus one (0: none yet; distances from [`MAX_DIST`] on are not kept, see
+/// [`CostToGo::relax`]), bits 32–62 `P` as `f32` bits (`P ≥ 1` or +∞ is positive, so its
+/// sign bit is not kept; 0.0: not computed yet, never a value), bit 63 settled. All-zero
+/// when untouched, so `vec![0u64; n]` is a zeroed allocation the system hands out
+/// lazily: pages are touched only where the search goes.
 trait NodeRecord {
     fn dist(self) -> Cost;
-    /// Sets a finite distance (`d < Cost::INFINITY`, as every relaxed one is).
+    /// Sets a distance below [`MAX_DIST`].
     fn set_dist(&mut self, d: Cost);
     fn pose(self) -> Option<f32>;
+    /// Sets a `P` that is positive (sign bit clear), as every one is.
     fn set_pose(&mut self, p: f32);
     fn done(self) -> bool;
     fn set_done(&mut self);
 }
 
-/// Bit 96 of a [`NodeRecord`]: settled.
-const DONE: u128 = 1 << 96;
+/// The bits of a [`NodeRecord`]'s distance.
+const DIST_FIELD: u64 = u32::MAX as u64;
+/// Distances kept in a [`NodeRecord`] lie below this (4294.97 cost units: many times
+/// any course's; a search that would go past it freezes there instead, see
+/// [`CostToGo::relax`]).
+const MAX_DIST: Cost = Cost(u32::MAX as u64 - 1);
+/// The bits of a [`NodeRecord`]'s `P`.
+const POSE_FIELD: u64 = (u32::MAX as u64 >> 1) << 32;
+/// Bit 63 of a [`NodeRecord`]: settled.
+const DONE: u64 = 1 << 63;
 
-impl NodeRecord for u128 {
+impl NodeRecord for u64 {
     #[inline]
     fn dist(self) -> Cost {
-        match self as u64 {
+        match self & DIST_FIELD {
             0 => Cost::INFINITY,
             v => Cost(v - 1),
         }
@@ -467,18 +502,20 @@ impl NodeRecord for u128 {
 
     #[inline]
     fn set_dist(&mut self, d: Cost) {
-        *self = (*self & !u128::from(u64::MAX)) | u128::from(d.0.saturating_add(1));
+        debug_assert!(d < MAX_DIST);
+        *self = (*self & !DIST_FIELD) | (d.0 + 1);
     }
 
     #[inline]
     fn pose(self) -> Option<f32> {
-        let v = f32::from_bits((self >> 64) as u32);
+        let v = f32::from_bits(((self & POSE_FIELD) >> 32) as u32);
         (v != 0.0).then_some(v)
     }
 
     #[inline]
     fn set_pose(&mut self, p: f32) {
-        *self = (*self & !(u128::from(u32::MAX) << 64)) | (u128::from(p.to_bits()) << 64);
+        debug_assert!(p.is_sign_positive());
+        *self = (*self & !POSE_FIELD) | ((u64::from(p.to_bits()) << 32) & POSE_FIELD);
     }
 
     #[inline]
@@ -490,6 +527,34 @@ impl NodeRecord for u128 {
     fn set_done(&mut self) {
         *self |= DONE;
     }
+}
+
+/// Queue entries between the one being taken and the one whose records are prefetched.
+const PREFETCH_AHEAD: usize = 8;
+
+/// Asks the cache for the records node `f`'s edges will touch: its own, the rows of its
+/// layer its drives reach (two cells either side, two rows up and down) and its
+/// neighbouring layers' (turns). A hint only: no effect on any result.
+#[inline]
+fn prefetch_neighbourhood(nodes: &[u64], f: usize, nx: usize, cells: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let at = |k: usize| {
+            if let Some(r) = nodes.get(k) {
+                // SAFETY: a prefetch is a hint that never faults; SSE is baseline on x86-64.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(r).cast()) };
+            }
+        };
+        for row in [f.wrapping_sub(2 * nx), f.wrapping_sub(nx), f, f + nx, f + 2 * nx] {
+            at(row.wrapping_sub(2));
+            at(row + 2);
+        }
+        at(f.wrapping_sub(cells));
+        at(f + cells);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (nodes, f, nx, cells);
 }
 
 /// The group (layer) of orientation `k`: groups of `group` consecutive orientations,
@@ -587,6 +652,13 @@ impl Buckets {
         self.bucket(d) == self.current
     }
 
+    /// The entry `k` places after the next one in the current bucket, if it holds one
+    /// (for prefetching the records it will touch).
+    fn ahead(&self, k: usize) -> Option<u32> {
+        let bucket = self.buckets.get(self.current)?;
+        bucket.len().checked_sub(k + 1).map(|i| bucket[i])
+    }
+
     fn pop(&mut self) -> Option<u32> {
         while self.len > 0 {
             if let Some(n) = self.buckets.get_mut(self.current).and_then(Vec::pop) {
@@ -626,13 +698,20 @@ mod tests {
 
     #[test]
     fn a_node_record_keeps_its_three_fields_apart() {
-        let mut r = 0u128;
+        let mut r = 0u64;
         assert_eq!((r.dist(), r.pose(), r.done()), (Cost::INFINITY, None, false));
         r.set_pose(f32::INFINITY);
-        r.set_dist(Cost(u64::MAX - 1));
+        r.set_dist(Cost(MAX_DIST.0 - 1));
         assert_eq!(
             (r.dist(), r.pose(), r.done()),
-            (Cost(u64::MAX - 1), Some(f32::INFINITY), false)
+            (Cost(MAX_DIST.0 - 1), Some(f32::INFINITY), false)
+        );
+        // Every bit of a P is kept (the same f32, the last mantissa bit included).
+        let p = f32::from_bits(1.5f32.to_bits() | 1);
+        r.set_pose(p);
+        assert_eq!(
+            (r.dist(), r.pose().map(f32::to_bits)),
+            (Cost(MAX_DIST.0 - 1), Some(p.to_bits()))
         );
         r.set_dist(Cost::ZERO);
         r.set_done();
@@ -792,5 +871,41 @@ mod tests {
         for (i, j, t) in [(10, 32, 0), (90, 32, 0), (99, 33, 1), (30, 5, 63)] {
             assert!(frozen.get(&maps, i, j, t) <= exact.get(&maps, i, j, t));
         }
+    }
+
+    #[test]
+    fn distances_past_the_records_cap_get_the_cap() {
+        // A cap at about the median distance (instead of MAX_DIST's 4295 cost units, which
+        // no test map reaches): below it the distances are the reference's, from it on
+        // every node gets the cap, min(D, cap), nodes with no path too (once capped, the
+        // search cannot tell them from far ones; the cap bounds both).
+        let (maps, lattice, driving) = setup();
+        let step = Cost::from_f64_floor(0.3);
+        let ctg = CostToGo::new(lattice, &driving, step, GOAL, (64, usize::MAX));
+        let (gi, gj, _) = GOAL;
+        let root = gj as usize * usize::from(lattice.nx) + gi as usize;
+        let want = reference_distances(&ctg, &maps, root);
+        let mut finite: Vec<Cost> = want.iter().copied().filter(|d| !d.is_infinite()).collect();
+        finite.sort_unstable();
+        let cap = finite[finite.len() / 2];
+        ctg.search.borrow_mut().cap = cap;
+        let (nx, ny) = (i16::try_from(lattice.nx).unwrap(), i16::try_from(lattice.ny).unwrap());
+        let (mut below, mut capped) = (0, 0);
+        for t in (0..64u8).step_by(7) {
+            for j in (0..ny).step_by(3) {
+                for i in 0..nx {
+                    let node = usize::from(t) * ctg.cells()
+                        + j as usize * usize::from(lattice.nx)
+                        + i as usize;
+                    let got = ctg.get(&maps, i, j, t);
+                    let d = want[node];
+                    assert_eq!(got, d.min(cap), "({i}, {j}, {t})");
+                    below += usize::from(d < cap);
+                    capped += usize::from(d >= cap && !d.is_infinite());
+                }
+            }
+        }
+        assert!(below > 1000 && capped > 1000, "{below} below, {capped} capped");
+        assert!(!ctg.frozen());
     }
 }
