@@ -72,7 +72,10 @@
 //! until that node is settled, and `P` is computed per node when the search first
 //! touches it. The graph (and with it this search) lives for one plan, so every ARA*
 //! iteration reuses what earlier ones settled. The queue is a bucket queue (Dial's
-//! algorithm; buckets no wider than the lightest edge), exact like a binary heap.
+//! algorithm; buckets no wider than the lightest edge), exact like a binary heap. The
+//! nodes' records keep distances below [`MAX_DIST`]; a search that would go past it
+//! answers `min(D, MAX_DIST)` instead, consistent like a deadline's frozen bound
+//! ([`CostToGo::set_deadline`]).
 
 use super::driving::DrivingConfig;
 use super::lattice::{Lattice, LatticeState};
