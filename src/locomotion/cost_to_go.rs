@@ -549,12 +549,14 @@ fn prefetch_neighbourhood(nodes: &[u64], f: usize, nx: usize, cells: usize) {
                 unsafe { _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(r).cast()) };
             }
         };
-        for row in [f.wrapping_sub(2 * nx), f.wrapping_sub(nx), f, f + nx, f + 2 * nx] {
+        // Off-the-array indices (rows above the first wrap around) are skipped by `at`.
+        for r in [-2, -1, 0, 1, 2isize] {
+            let row = f.wrapping_add_signed(r.wrapping_mul(nx as isize));
             at(row.wrapping_sub(2));
-            at(row + 2);
+            at(row.wrapping_add(2));
         }
         at(f.wrapping_sub(cells));
-        at(f + cells);
+        at(f.wrapping_add(cells));
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = (nodes, f, nx, cells);
