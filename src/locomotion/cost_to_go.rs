@@ -486,8 +486,8 @@ trait NodeRecord {
 /// The bits of a [`NodeRecord`]'s distance.
 const DIST_FIELD: u64 = u32::MAX as u64;
 /// Distances kept in a [`NodeRecord`] lie below this (4294.97 cost units: many times
-/// any course's; a search that would go past it freezes there instead, see
-/// [`CostToGo::relax`]).
+/// any course's; a search that would go past it is capped there instead, its unsettled
+/// nodes answered with this bound, see [`CostToGo::relax`]).
 const MAX_DIST: Cost = Cost(u32::MAX as u64 - 1);
 /// The bits of a [`NodeRecord`]'s `P`.
 const POSE_FIELD: u64 = (u32::MAX as u64 >> 1) << 32;
