@@ -7,8 +7,13 @@ use momaro::jobs::plan::PlanOptions;
 use momaro::jobs::run::{PoseNoise, RunOptions, RunSummary, run};
 
 fn run_scenario(name: &str, noise: Option<PoseNoise>) -> RunSummary {
-    // A generous planning budget: CI machines are slow and this is not a speed test.
-    run_planned(name, noise, PlanOptions { time_limit_s: 60.0, ..PlanOptions::default() })
+    // ARA*'s first solution: the same plan on any machine (a time limit would cut the
+    // anytime search wherever the CPU happens to be).
+    run_planned(
+        name,
+        noise,
+        PlanOptions { time_limit_s: 600.0, final_epsilon: Some(3.0), ..PlanOptions::default() },
+    )
 }
 
 fn run_planned(name: &str, noise: Option<PoseNoise>, plan: PlanOptions) -> RunSummary {
