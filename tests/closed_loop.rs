@@ -7,13 +7,7 @@ use momaro::jobs::plan::PlanOptions;
 use momaro::jobs::run::{PoseNoise, RunOptions, RunSummary, run};
 
 fn run_scenario(name: &str, noise: Option<PoseNoise>) -> RunSummary {
-    // ARA*'s first solution: the same plan on any machine (a time limit would cut the
-    // anytime search wherever the CPU happens to be).
-    run_planned(
-        name,
-        noise,
-        PlanOptions { time_limit_s: 600.0, final_epsilon: Some(3.0), ..PlanOptions::default() },
-    )
+    run_planned(name, noise, common::first_solution())
 }
 
 fn run_planned(name: &str, noise: Option<PoseNoise>, plan: PlanOptions) -> RunSummary {
@@ -126,9 +120,8 @@ fn a_plan_whose_base_drops_at_an_edge_keeps_the_wheels_loaded() {
 /// passes with at least 2 cm of margin and no static violation at all.
 fn drives_generated_clutter_on_all_wheels(seed: u64) {
     let sc = common::generated(momaro::scenario::generate::Class::Clutter, seed);
-    let plan =
-        PlanOptions { time_limit_s: 600.0, final_epsilon: Some(3.0), ..PlanOptions::default() };
-    let s = run(&sc, &RunOptions::new(plan, common::model())).expect("run completes");
+    let s = run(&sc, &RunOptions::new(common::first_solution(), common::model()))
+        .expect("run completes");
     assert!(s.passed, "{s:#?}");
     assert!(s.min_stability_margin_m >= 0.02, "{s:#?}");
     assert_eq!(s.static_violation_s, 0.0, "{:?}", s.events);

@@ -9,8 +9,9 @@
 
 mod common;
 
+use common::{first_solution, probe_path};
+
 use momaro::jobs::plan::{self, PathElement, PathKind, PlanOptions, PlanSummary};
-use momaro::locomotion::Algorithm;
 use momaro::motion::{DetailedPath, MotionError, MotionOptions, Phase, ZMP_SHIFT_M, expand_path};
 use momaro::robot::Leg;
 use momaro::scenario::Scenario;
@@ -24,22 +25,6 @@ fn scenario(name: &str) -> Scenario {
 
 fn sim() -> Simulation {
     Simulation::robot_only(&default_model_path()).expect("model compiles")
-}
-
-/// ARA*'s first solution at ε = 3: the same plan on any machine.
-fn first_solution() -> PlanOptions {
-    PlanOptions {
-        algorithm: Algorithm::AraStar,
-        time_limit_s: 600.0,
-        final_epsilon: Some(3.0),
-        ..PlanOptions::default()
-    }
-}
-
-/// ARA*'s probe's path (`plan --schedule-expansions 0`): the same plan on any machine,
-/// where the schedule to ε = 3 costs a search the test does not need.
-fn probe_path() -> PlanOptions {
-    PlanOptions { schedule_expansions: Some(0), ..first_solution() }
 }
 
 fn expand(

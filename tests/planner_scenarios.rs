@@ -19,6 +19,8 @@ use std::time::Instant;
 
 mod common;
 
+use common::{first_solution, probe_path};
+
 fn robot() -> RobotDescription {
     momaro::sim::Simulation::robot_only(&momaro::sim::default_model_path())
         .expect("the model compiles")
@@ -49,17 +51,6 @@ fn arastar(time_limit_s: f64) -> PlanOptions {
 /// many nodes (3.8M against 1.2M on `ramp_far`) and takes 1.3 times as long.
 fn optimum() -> PlanOptions {
     PlanOptions { algorithm: Algorithm::AStar, time_limit_s: 600.0, ..PlanOptions::default() }
-}
-
-/// ARA*'s first solution (ε = 3), whatever the machine's speed: the same plan everywhere.
-fn first_solution() -> PlanOptions {
-    PlanOptions { final_epsilon: Some(3.0), ..arastar(600.0) }
-}
-
-/// ARA*'s probe's path, as `plan --schedule-expansions 0` finds it: the same plan on any
-/// machine, found in a few thousand expansions.
-fn probe_path() -> PlanOptions {
-    PlanOptions { schedule_expansions: Some(0), ..first_solution() }
 }
 
 /// The staircase's [`probe_path`], planned once for the tests that read it. It is what
@@ -264,7 +255,7 @@ fn stairs_written_without_models_get_the_ones_that_climb_them() {
     // Building-code flights as a user writes them, naming no models: three steps (the
     // paper's r_F disc leaves 5 cm of each 0.29 m tread, and the search had no path) and
     // six (the paper's manoeuvres cannot climb a flight longer than the robot).
-    let probe = PlanOptions { schedule_expansions: Some(0), ..first_solution() };
+    let probe = probe_path();
     for (name, step_model, climbed) in
         [("stairs_indoor", StepModel::Paper, 12), ("stairs_long", StepModel::Stairs, 24)]
     {
@@ -521,12 +512,7 @@ fn the_probe_answers_where_the_schedule_runs_out() {
 fn a_guided_probe_climbs_open_sided_stairs_its_heuristic_alone_floods_beside() {
     for seed in [4, 11] {
         let s = common::generated(momaro::scenario::generate::Class::Stairs, seed);
-        let probe_only = PlanOptions {
-            final_epsilon: Some(3.0),
-            schedule_expansions: Some(0),
-            max_expansions: Some(50_000),
-            ..arastar(600.0)
-        };
+        let probe_only = PlanOptions { max_expansions: Some(50_000), ..probe_path() };
         let unguided = PlanOptions { probe_guidance: false, ..probe_only.clone() };
         assert_stopped_by_expansion_limit(&run(&s, &robot(), &unguided), &format!("seed {seed}"));
         let p = plan(&s, &probe_only);
@@ -546,12 +532,7 @@ fn the_probe_steps_down_0_3_m_without_first_searching_the_whole_platform() {
     // line, so that shift stood on a hill it crossed only after the whole platform at
     // every heading: 98,285 expansions. Weighed at a quarter each, the shift is level:
     // 30,427.
-    let probe_only = PlanOptions {
-        final_epsilon: Some(3.0),
-        schedule_expansions: Some(0),
-        max_expansions: Some(60_000),
-        ..arastar(600.0)
-    };
+    let probe_only = PlanOptions { max_expansions: Some(60_000), ..probe_path() };
     let p = plan(&scenario("step_down"), &probe_only);
     let probe = &p.solutions[0];
     assert_eq!(probe.epsilon, 50.0);

@@ -12,6 +12,8 @@
 
 mod common;
 
+use common::{first_solution, probe_path};
+
 use momaro::control::step_executor::{ExecEventKind, ExecFailure};
 use momaro::jobs::envelope::{self, Direction};
 use momaro::jobs::plan::{self, PathKind, PlanOptions, PlanSummary};
@@ -21,16 +23,6 @@ use momaro::robot::Leg;
 use momaro::scenario::Scenario;
 use momaro::sim::Simulation;
 use std::time::Instant;
-
-fn plan_options() -> PlanOptions {
-    // ARA*'s first solution: the same plan on any machine.
-    PlanOptions { time_limit_s: 600.0, final_epsilon: Some(3.0), ..PlanOptions::default() }
-}
-
-/// The probe's path, as `plan --schedule-expansions 0` finds it.
-fn probe_path() -> PlanOptions {
-    PlanOptions { schedule_expansions: Some(0), ..plan_options() }
-}
 
 /// Where an executed prefix of a plan ends.
 #[derive(Debug, Clone, Copy)]
@@ -90,8 +82,8 @@ fn execute_prefix(sc: &Scenario, end: End, push: Option<Push>) -> RunSummary {
     let wall = Instant::now();
     let mut sim = Simulation::new(sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
-    let mut prep = plan::prepare_for(sc, &robot, &plan_options()).expect("maps");
-    let plan = plan::run_on(&prep, sc, &robot, &plan_options()).expect("plan");
+    let mut prep = plan::prepare_for(sc, &robot, &first_solution()).expect("maps");
+    let plan = plan::run_on(&prep, sc, &robot, &first_solution()).expect("plan");
     let mut end = prefix_end(&plan, end);
     assert!(end < plan.path.len(), "the prefix ends before the goal");
     // Without the planned base shift that prepares a rear step up: it moves the base
@@ -104,7 +96,7 @@ fn execute_prefix(sc: &Scenario, end: End, push: Option<Push>) -> RunSummary {
     let detailed = prefix_keyframes(sc, &mut sim, &plan, end);
     momaro::jobs::stand_at_start(&mut sim, sc).expect("stands");
     let opts =
-        RunOptions { max_replans: 0, push, ..RunOptions::new(plan_options(), common::model()) };
+        RunOptions { max_replans: 0, push, ..RunOptions::new(first_solution(), common::model()) };
     let mission = Mission { plan, detailed };
     let s = run::execute(sc, &mut prep, &mut sim, mission, &opts, wall).expect("runs");
     println!(
@@ -173,7 +165,7 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
     // step was aborted (measured with an earlier plan).
     let robot = Simulation::robot_only(&common::model()).expect("model").robot().clone();
     let step =
-        first_step_up(&plan::run(&sc, &robot, &plan_options()).expect("plan"), Leg::FrontLeft);
+        first_step_up(&plan::run(&sc, &robot, &first_solution()).expect("plan"), Leg::FrontLeft);
     let push = Push {
         when: PushWhen::Step { step, phase: Phase::Swing, delay_s: 1.0 },
         force: [0.0, 300.0, 0.0],
@@ -246,7 +238,7 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
 
 /// The whole mission (`momaro run`): plan, expand, execute with replanning.
 fn run_whole(name: &str) -> RunSummary {
-    run_whole_with(name, plan_options())
+    run_whole_with(name, first_solution())
 }
 
 /// [`run_whole`] with planner options `plan`.
@@ -426,7 +418,7 @@ fn an_aborted_step_returns_to_the_driving_posture_and_replans() {
 #[test]
 fn a_generated_step_down_keeps_its_knees_off_the_edge() {
     let sc = common::generated(momaro::scenario::generate::Class::StepDown, 98);
-    let s = run::run(&sc, &RunOptions::new(plan_options(), common::model())).expect("run");
+    let s = run::run(&sc, &RunOptions::new(first_solution(), common::model())).expect("run");
     assert!(s.steps_planned > 0);
     assert_clean(&s);
     assert!(s.passed, "{s:#?}");
@@ -461,7 +453,7 @@ fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) 
         run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
     momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
     // Replans (if any) plan with the executor's parameters.
-    let mut prep = plan::prepare_for(&sc, &robot, &plan_options()).expect("maps");
+    let mut prep = plan::prepare_for(&sc, &robot, &first_solution()).expect("maps");
     let mission = Mission { plan, detailed };
     let s = run::execute(&sc, &mut prep, &mut sim, mission, &opts, wall).expect("runs");
     (s, sim)
@@ -471,7 +463,7 @@ fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) 
 /// robot returns to the driving posture and the run stops. With `push`.
 fn aborted_platform(push: Option<Push>) -> RunSummary {
     let opts =
-        RunOptions { max_replans: 0, push, ..RunOptions::new(plan_options(), common::model()) };
+        RunOptions { max_replans: 0, push, ..RunOptions::new(first_solution(), common::model()) };
     execute_unliftable("platform", opts).0
 }
 
@@ -549,7 +541,7 @@ fn a_stance_turned_by_its_rolls_is_turned_back_and_both_flights_are_climbed() {
     // static violation. (The smallest margin on four wheels, 0.8 cm at a roll whose base
     // still stands turned against its feet, is open: the README's "Stance slide".)
     let sc = common::generated(momaro::scenario::generate::Class::Stairs, 10);
-    let s = run::run(&sc, &RunOptions::new(plan_options(), common::model())).expect("run");
+    let s = run::run(&sc, &RunOptions::new(first_solution(), common::model())).expect("run");
     assert!(s.reached_goal && s.failure.is_none(), "{:?} {:?}", s.failure, s.executor_events);
     assert!(!s.tipped && s.static_violation_s == 0.0, "{:?}", s.events);
     assert!(s.steps_planned >= 30, "{}", s.steps_planned);
@@ -612,7 +604,7 @@ fn a_descent_planned_with_a_leg_at_full_reach_is_now_planned_with_reach_to_spare
 /// Runs `sc` as `momaro run` does with the tests' planner options, prints its outcome, and
 /// asserts that it passed cleanly ([`assert_clean`]).
 fn run_clean(sc: &Scenario) -> RunSummary {
-    let s = run::run(sc, &RunOptions::new(plan_options(), common::model())).expect("run");
+    let s = run::run(sc, &RunOptions::new(first_solution(), common::model())).expect("run");
     println!(
         "{}: goal {:.3} m, {} of {} steps, min margin {:.3} m, wall {:.1} s",
         sc.name,
