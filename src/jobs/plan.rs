@@ -355,6 +355,9 @@ pub struct PlanSummary {
     pub heuristic: HeuristicSummary,
     /// Distinct footprints met.
     pub footprints: usize,
+    /// The manoeuvres the search generated and how its step checks (the motion
+    /// generator's, run by the planner) ended.
+    pub manoeuvres: ManoeuvreStats,
     /// The step-related factor used.
     pub step_cost_factor: f64,
     /// The foot model used (`paper` or `wheel_pair`).
@@ -915,6 +918,7 @@ fn search_prepared(
             reused: graph.heuristic_reused(),
         },
         footprints: graph.footprint_count(),
+        manoeuvres: graph.stats(),
         step_cost_factor: prep.params.step_cost_factor,
         foot_model: prep.params.foot_model,
         step_model: prep.params.step_model,

@@ -76,7 +76,9 @@ use crate::feasibility::{DrivingCheck, Infeasible};
 use crate::geometry::{Pose2, wrap_angle};
 use crate::jobs::plan::{PathElement, PathKind};
 use crate::params::{Params, StepModel};
+use crate::planner::FxBuild;
 use crate::robot::{Leg, RobotDescription};
+use std::collections::HashMap;
 
 /// Constants of the expansion.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -248,6 +250,7 @@ fn kind_name(k: PathKind) -> &'static str {
 }
 
 /// A segment that passed: its end evaluation, smallest margins and sample count.
+#[derive(Debug, Clone)]
 struct SegmentCheck {
     end: Evaluation,
     min_margin: f64,
@@ -270,6 +273,43 @@ struct Expander<'a> {
     min_margin: f64,
     min_three: f64,
     index: usize,
+    /// The checks of the step being searched ([`StepChecks`]); `None` outside a step's
+    /// candidate search.
+    checked: Option<StepChecks>,
+}
+
+/// The outcomes of the posture and segment checks within one step's candidate search
+/// ([`Expander::expand_step_at`]), by the postures' exact bits. A step's candidates share
+/// keyframes and whole segments (those differing only in their base shift share the
+/// wheel move and the roll; every trial re-checks the lift its early check passed, and
+/// every segment walk ends on a keyframe the trial checked first): on a generated mixed
+/// course (seed 20002) 27 % of the 6.6 M postures the planner's step checks evaluated
+/// had been evaluated in the same step before. Both checks are pure functions of their
+/// postures (the robot, maps, CoM model and options are fixed), so a remembered outcome
+/// is the outcome. Interpolated samples are not remembered one by one (their segment
+/// is): hashing each cost more than the few repeats saved.
+#[derive(Default)]
+struct StepChecks {
+    postures: HashMap<PostureBits, Result<Evaluation, Infeasible>, FxBuild>,
+    segments: HashMap<(PostureBits, PostureBits, bool), SegmentOutcome, FxBuild>,
+}
+
+/// What [`Expander::check_segment`] finds: the segment's check, or where along it (0–1)
+/// and why it failed.
+type SegmentOutcome = Result<SegmentCheck, (f64, Infeasible)>;
+
+/// A posture's exact bits: base position and roll, pitch, yaw, the four feet, and the
+/// contact flags.
+type PostureBits = ([u64; 18], u8);
+
+fn posture_bits(p: &Posture) -> PostureBits {
+    let mut bits = [0u64; 18];
+    let values = p.base_position.iter().chain(&p.base_rpy).chain(p.feet.iter().flatten());
+    for (b, v) in bits.iter_mut().zip(values) {
+        *b = v.to_bits();
+    }
+    let contact = p.contact.iter().enumerate().fold(0u8, |m, (k, &c)| m | (u8::from(c) << k));
+    (bits, contact)
 }
 
 /// A planned keyframe before checking.
@@ -297,6 +337,7 @@ impl<'a> Expander<'a> {
             min_margin: f64::INFINITY,
             min_three: f64::INFINITY,
             index: 0,
+            checked: None,
         }
     }
 
@@ -389,8 +430,25 @@ impl<'a> Expander<'a> {
     }
 
     /// Checks one posture: the leg IK with the reach margin, thighs and shins clear of the
-    /// terrain, and the stability margin.
+    /// terrain, and the stability margin. Within a step's candidate search, remembered
+    /// ([`StepChecks`]).
     fn check_posture(&mut self, p: &Posture) -> Result<Evaluation, Infeasible> {
+        if self.checked.is_none() {
+            return self.evaluate_posture(p);
+        }
+        let key = posture_bits(p);
+        if let Some(known) = self.checked.as_ref().and_then(|c| c.postures.get(&key)) {
+            return known.clone();
+        }
+        let outcome = self.evaluate_posture(p);
+        if let Some(c) = self.checked.as_mut() {
+            c.postures.insert(key, outcome.clone());
+        }
+        outcome
+    }
+
+    /// [`Self::check_posture`] unremembered.
+    fn evaluate_posture(&mut self, p: &Posture) -> Result<Evaluation, Infeasible> {
         let o = self.o;
         // The clearance before the CoM: a posture it rejects needs none.
         let legs = solve_chains(self.robot, p, o.standing.reach_margin_m)?;
@@ -404,13 +462,26 @@ impl<'a> Expander<'a> {
     }
 
     /// Checks the segment from `a` to `b` (interpolated points and `b`); `drive` keeps the
-    /// feet in the neutral footprint under the moving base.
-    fn check_segment(
-        &mut self,
-        a: &Posture,
-        b: &Posture,
-        drive: bool,
-    ) -> Result<SegmentCheck, (f64, Infeasible)> {
+    /// feet in the neutral footprint under the moving base. Within a step's candidate
+    /// search, remembered ([`StepChecks`]).
+    fn check_segment(&mut self, a: &Posture, b: &Posture, drive: bool) -> SegmentOutcome {
+        if self.checked.is_none() {
+            return self.walk_segment(a, b, drive);
+        }
+        let key = (posture_bits(a), posture_bits(b), drive);
+        if let Some(known) = self.checked.as_ref().and_then(|c| c.segments.get(&key)) {
+            return known.clone();
+        }
+        let outcome = self.walk_segment(a, b, drive);
+        if let Some(c) = self.checked.as_mut() {
+            c.segments.insert(key, outcome.clone());
+        }
+        outcome
+    }
+
+    /// [`Self::check_segment`] unremembered: every sample evaluated, the end (a
+    /// keyframe) by [`Self::check_posture`].
+    fn walk_segment(&mut self, a: &Posture, b: &Posture, drive: bool) -> SegmentOutcome {
         let o = self.o;
         let dist = |p: [f64; 3], q: [f64; 3]| {
             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
@@ -443,7 +514,8 @@ impl<'a> Expander<'a> {
                 }
                 p.base_position[2] += rise;
             }
-            let e = self.check_posture(&p).map_err(|cause| (t, cause))?;
+            let e = if j == n { self.check_posture(&p) } else { self.evaluate_posture(&p) };
+            let e = e.map_err(|cause| (t, cause))?;
             min_margin = min_margin.min(e.margin);
             if p.contact.iter().filter(|&&c| c).count() == 3 {
                 min_three = min_three.min(e.margin);
@@ -880,8 +952,23 @@ impl<'a> Expander<'a> {
     }
 
     /// [`Self::expand_step`] at the leg heights `heights` (lazily: the planner's check
-    /// takes the next height only when every candidate at the ones before failed).
+    /// takes the next height only when every candidate at the ones before failed), its
+    /// posture checks remembered while the candidates are searched ([`StepChecks`]).
     fn expand_step_at(
+        &mut self,
+        leg: Leg,
+        post_foot: [f64; 3],
+        search: StepSearch,
+        heights: impl Iterator<Item = f64>,
+    ) -> Result<(), MotionError> {
+        self.checked = Some(StepChecks::default());
+        let outcome = self.search_step_candidates(leg, post_foot, search, heights);
+        self.checked = None;
+        outcome
+    }
+
+    /// [`Self::expand_step_at`]'s search.
+    fn search_step_candidates(
         &mut self,
         leg: Leg,
         post_foot: [f64; 3],
@@ -1503,5 +1590,70 @@ mod tests {
         assert!((zmp_duration(&b, coms, 0.01) - t).abs() < 1e-12);
         assert_eq!(zmp_duration(&b, [coms[1]; 2], 0.01), 0.0);
         assert_eq!(zmp_duration(&b, [[f64::NAN; 3], coms[1]], 0.01), 0.0);
+    }
+
+    #[test]
+    fn remembered_step_checks_find_what_unremembered_ones_find() {
+        // A step's candidate search remembers its posture and segment checks
+        // (`StepChecks`): the outcome, the reported failure and the keyframes committed
+        // are those of the search without. Steps of every leg, from stances before the
+        // paper's 0.2 m platform and on it, onto footholds on the floor, at the edge and
+        // on top, forward and back; both candidate sets.
+        use crate::scenario::terrain::Primitive;
+        use crate::terrain::rasterise::rasterise;
+        let robot = RobotDescription::reference();
+        let params = Params::default();
+        let prims =
+            [Primitive::Box { center: [2.0, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 }];
+        let map = rasterise(&prims, [-1.0, -1.0], [4.0, 2.0], 0.025).expect("map");
+        let maps = CostMaps::build(&map, &robot, &params).expect("cost maps");
+        let options = MotionOptions::from_params(&params);
+        let rule = options.standing;
+        let ground = |x: f64, y: f64| [x, y, maps.height_at(x, y).expect("ground")];
+        let (mut held, mut failed) = (0, 0);
+        for x in [0.45, 0.5, 0.6, 1.1875, 1.6] {
+            let pose = Pose2::new(x, 0.0, 0.0);
+            let feet = maps.neutral_feet(&pose).map(|[fx, fy]| ground(fx, fy));
+            // Where a knee would touch the edge there is no stance to step from.
+            let Ok((pre, _)) = rule.stand(&robot, maps.leg_terrain(), feet, [x, 0.0], 0.0) else {
+                continue;
+            };
+            for leg in Leg::ALL {
+                let f = feet[leg.index()];
+                for d in [-0.2, 0.1, 0.2, 0.3, 0.45] {
+                    let post = ground(f[0] + d, f[1]);
+                    for search in [StepSearch::Planner, StepSearch::Full] {
+                        let run = |remember: bool| {
+                            let heights = rule.step_heights(
+                                &robot,
+                                maps.heights(),
+                                maps.leg_terrain(),
+                                feet,
+                                leg.index(),
+                                post,
+                                [x, 0.0],
+                                0.0,
+                            );
+                            let mut model = super::super::standing::EstimatedCom { robot: &robot };
+                            let mut e = Expander::at(&robot, &maps, &mut model, &options, pre);
+                            let r = if remember {
+                                e.expand_step_at(leg, post, search, heights)
+                            } else {
+                                e.search_step_candidates(leg, post, search, heights)
+                            };
+                            (r, e.keys)
+                        };
+                        let remembered = run(true);
+                        assert_eq!(remembered, run(false), "{leg:?} from x = {x} by {d} m");
+                        if remembered.0.is_ok() {
+                            held += 1;
+                        } else {
+                            failed += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(held > 10 && failed > 10, "{held} held, {failed} failed");
     }
 }
