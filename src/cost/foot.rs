@@ -317,6 +317,21 @@ impl FootCostLayer {
         }
     }
 
+    /// Everything the layer holds for cell `k` (row-major), as bits: the value, and the
+    /// wheel-pair model's flags and finite value (zero for the paper's model).
+    pub(crate) fn cell_bits(&self, k: usize) -> [u64; 4] {
+        let value = self.values.get(k).map_or(u64::MAX, |v| v.to_bits());
+        match &self.headings {
+            None => [value, 0, 0, 0],
+            Some(h) => [
+                value,
+                h.infinite.get(k).copied().unwrap_or(u64::MAX),
+                h.unknown.get(k).copied().unwrap_or(u64::MAX),
+                h.finite.get(k).map_or(u64::MAX, |v| v.to_bits()),
+            ],
+        }
+    }
+
     /// The heading bins at which cell `k` (row-major) has a finite C_F, as bits (every
     /// bit or none for the paper's model).
     #[inline]

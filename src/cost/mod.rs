@@ -19,6 +19,7 @@
 pub mod body;
 pub mod foot;
 pub mod pose;
+pub mod prints;
 
 pub use body::{BodyGeometry, DiscMaxLayer};
 pub use foot::{FootCostLayer, HeadingBin, WheelPair, height_differences};
@@ -187,6 +188,24 @@ impl CostMaps {
             driving_leg_height: params.driving_leg_height_m,
             unknown_heights: map.len() - map.known_count(),
         })
+    }
+
+    /// A signature of everything the layers hold at cell (i, j) of the map (heights, leg
+    /// terrains, the body's disc maximum, the foot cost at every heading): equal
+    /// signatures, equal cells (up to a hash collision). For [`prints::TerrainPrints`].
+    pub fn cell_signature(&self, i: usize, j: usize) -> u64 {
+        let foot = self.foot.cell_bits(j * self.heights.nx() + i);
+        let disc = self.disc_max.get(i, j).map_or(u64::MAX, f64::to_bits);
+        prints::signature(
+            [
+                self.heights.raw(i, j).to_bits(),
+                self.leg_terrain.raw(i, j).to_bits(),
+                self.swept_leg_terrain.raw(i, j).to_bits(),
+                disc,
+            ]
+            .into_iter()
+            .chain(foot),
+        )
     }
 
     /// The height map the costs were computed from.

@@ -1238,7 +1238,8 @@ fn row(
 }
 
 /// How a search's step checks ended, for a failure's message: `; of N step checks M
-/// failed: …` (empty when no step was checked). Where the steps fail says what stopped
+/// failed: …` and how many steps failed checks elsewhere turned away (empty when no
+/// step was checked). Where the steps fail says what stopped
 /// the search: no leg height within reach, or front or rear steps with no stable motion.
 fn step_checks_said(stats: &ManoeuvreStats) -> String {
     let failed = stats.steps_failed();
@@ -1246,9 +1247,13 @@ fn step_checks_said(stats: &ManoeuvreStats) -> String {
     if checked == 0 {
         return String::new();
     }
+    let copies = match stats.step_failures_translated {
+        0 => String::new(),
+        n => format!("; {n} more steps turned away as copies of failed checks elsewhere"),
+    };
     format!(
         "; of {checked} step checks {failed} failed: {} with no leg height within reach, \
-         {} front and {} rear steps with no stable motion, {} otherwise",
+         {} front and {} rear steps with no stable motion, {} otherwise{copies}",
         stats.steps_without_leg_height,
         stats.front_steps_unstable,
         stats.rear_steps_unstable,
@@ -1277,6 +1282,10 @@ mod tests {
             "; of 20 step checks 10 failed: 4 with no leg height within reach, 3 front and \
              2 rear steps with no stable motion, 1 otherwise"
         );
+        let copied = ManoeuvreStats { step_failures_translated: 7, ..stats };
+        assert!(super::step_checks_said(&copied).ends_with(
+            "1 otherwise; 7 more steps turned away as copies of failed checks elsewhere"
+        ),);
     }
 
     #[test]

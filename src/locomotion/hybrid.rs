@@ -125,6 +125,26 @@
 //! step from the pose, and out of it because the step taken is one of the `c`.
 //! `labelled_successors` and [`HybridGraph::edge`] give the checked steps directly.
 //!
+//! **Translated step failures** (issue 15). A step check that failed is remembered by
+//! the terrain it read, its stance and its step, not by where it stood: the
+//! orientation, footprint, leg and new offset, and the print of every map layer over a
+//! window that holds everything the check reads (`cost::prints`; the window below). A
+//! check from another cell with the same key fails without being run. Along a straight
+//! edge, a stair's riser or a wall the terrain repeats cell by cell, and a search whose
+//! heuristic cannot tell the cells apart tries the same failing step at each: on the
+//! 0.3 m step-down scenario 31 k of its 31 k step checks failed, most of them copies.
+//! Only failures are taken over. A check reads the maps at points computed from its
+//! absolute pose, so where one lands within rounding of a cell boundary a translated
+//! copy may read the neighbouring cell: a remembered failure can turn away a step the
+//! exact check would pass there (a lost option, never a plan the generator cannot
+//! expand), and a remembered success could admit one it would fail. The window is the
+//! box of the feet before and after the step, widened by the foot link, half the wheel
+//! track, the wheel radius and a margin, and of the base's corners and hips, widened by
+//! the largest base shift of a step candidate, the thigh and the margin: every leg
+//! point lies within a thigh of its hip or between its knee and its foot, every foot
+//! the check moves stays between the stance's feet, and the base moves only by the
+//! candidates' shift (`HybridConfig::reuse_translated_step_failures`).
+//!
 //! **Heuristic** (issues 4 and 15): `max(h_E, D) + S + Φ`, clamped at zero, where
 //!
 //! 1. `h_E` is that of [`DrivingGraph`]: Euclidean distance plus the orientation
@@ -160,6 +180,7 @@ use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{STEP_HEIGHT_TOLERANCE_M, StepBound, StepBoundParams, offsets_weighed};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use super::reachability::{BaseRegions, StanceLimits};
+use crate::cost::prints::TerrainPrints;
 use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
@@ -172,7 +193,7 @@ use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
 use serde::Serialize;
 use std::cell::{Cell, OnceCell, RefCell};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
@@ -287,6 +308,9 @@ pub struct HybridConfig {
     pub max_oriented_nodes: usize,
     /// Smallest stability margin of a posture, m (the generator's requirement).
     pub min_stability_margin_m: f64,
+    /// Whether a step check that failed answers the same check on the same terrain at
+    /// another cell (module docs, "Translated step failures").
+    pub reuse_translated_step_failures: bool,
     /// The motion generator's constants: the leg-height rule for standing manoeuvres
     /// (reach and leg clearance, Sec. VI-B), the driving leg height, the base circles'
     /// radius, the wheel-to-centre move and gap of a step; with them steps are checked
@@ -294,6 +318,16 @@ pub struct HybridConfig {
     /// [`PLANNER_MARGIN_SLACK_M`].
     pub motion: MotionOptions,
 }
+
+/// A step check by what it reads and does (`HybridGraph::translated_step`): the print
+/// of its window, the window's cells relative to the state's, the orientation, the
+/// footprint's offsets, the leg and its new offset.
+type TranslatedStep = (u128, [i16; 4], u8, FootOffsets, u8, i8);
+
+/// Margin of a translated step's window beyond the reach it bounds, m (with two cells
+/// more): the base's pitch and roll move the hips a few centimetres, and bilinear
+/// reads take the next cell.
+const TRANSLATION_WINDOW_MARGIN_M: f64 = 0.05;
 
 /// How the robot stands on a footprint at a lattice pose (`HybridGraph::stand`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -363,6 +397,7 @@ impl HybridConfig {
             cost_to_go_groups: super::cost_to_go::ORIENTATION_GROUPS,
             max_oriented_nodes: super::cost_to_go::MAX_ORIENTED_NODES,
             min_stability_margin_m: params.min_stability_margin_m,
+            reuse_translated_step_failures: true,
             motion: {
                 let mut m = MotionOptions::from_params(params);
                 m.min_margin_m += PLANNER_MARGIN_SLACK_M;
@@ -411,6 +446,9 @@ pub struct ManoeuvreStats {
     /// Step checks that failed otherwise (no standing posture before the step, unknown
     /// terrain).
     pub steps_failed_otherwise: u64,
+    /// Steps turned away, without a check, by a failed check of the same step on the
+    /// same terrain at another cell (module docs, "Translated step failures").
+    pub step_failures_translated: u64,
 }
 
 impl ManoeuvreStats {
@@ -516,6 +554,11 @@ pub struct HybridGraph<'c> {
     /// [`Self::step_feasible`] by the state a step starts from, the leg and its new
     /// offset: ARA* expands a state again in each iteration.
     step_checks: HashMap<(PoseKey, u8, i8), bool, FxBuild>,
+    /// The failed step checks by what they read and did, wherever they stood (module
+    /// docs, "Translated step failures").
+    translated_failures: HashSet<TranslatedStep, FxBuild>,
+    /// The maps' translation-invariant prints, built at the first step check.
+    prints: OnceCell<TerrainPrints>,
     /// [`Self::wheel_segment_ok`] by the pose and footprint a one-cell wheel move starts
     /// from, the leg and its new offset.
     wheel_move_checks: HashMap<(PoseKey, u8, i8), bool, FxBuild>,
@@ -722,6 +765,8 @@ impl<'c> HybridGraph<'c> {
             wheel_move_checks: HashMap::default(),
             base_shift_checks: HashMap::default(),
             step_checks: HashMap::default(),
+            translated_failures: HashSet::default(),
+            prints: OnceCell::new(),
         })
     }
 
@@ -1387,12 +1432,77 @@ impl<'c> HybridGraph<'c> {
                 return None;
             }
             let ok = known.unwrap_or_else(|| {
-                let ok = self.step_feasible(s, feet, leg, foothold);
+                let translated = self.translated_step(s, o, feet, leg, o2[leg], foothold);
+                let ok = if translated.is_some_and(|t| self.translated_failures.contains(&t)) {
+                    self.count(|c| &mut c.step_failures_translated);
+                    false
+                } else {
+                    let ok = self.step_feasible(s, feet, leg, foothold);
+                    if let (false, Some(t)) = (ok, translated) {
+                        self.translated_failures.insert(t);
+                    }
+                    ok
+                };
                 self.step_checks.insert(key, ok);
                 ok
             });
             ok.then_some((o2, cost))
         })
+    }
+
+    /// The key of the step of `leg` from `s` (offsets `o`, feet `feet`) to `foothold`
+    /// (new offset `to`) among the translated failures: the print of the window the
+    /// check reads, relative to `s`'s cell, with the stance and the step (module docs,
+    /// "Translated step failures"). `None` where the window leaves the prints' padding,
+    /// or with the reuse turned off.
+    fn translated_step(
+        &self,
+        s: LatticeState,
+        o: &FootOffsets,
+        feet: &Feet,
+        leg: usize,
+        to: i8,
+        foothold: [f64; 3],
+    ) -> Option<TranslatedStep> {
+        if !self.config.reuse_translated_step_failures {
+            return None;
+        }
+        let r = &self.robot;
+        let res = self.lattice.resolution;
+        let margin = TRANSLATION_WINDOW_MARGIN_M + 2.0 * res;
+        let prints = self.prints.get_or_init(|| {
+            let reach =
+                r.max_leg_length() + r.hips.iter().map(|h| h[0].hypot(h[1])).fold(0.0, f64::max);
+            let far = reach + self.config.motion.max_base_shift_m + r.wheel_track + margin;
+            TerrainPrints::new(self.maps, (far / res).ceil() as usize + 2)
+        });
+        let pose = self.lattice.pose(s);
+        let (sin, cos) = pose.theta.sin_cos();
+        let world = |[x, y]: [f64; 2]| [pose.x + cos * x - sin * y, pose.y + sin * x + cos * y];
+        let [hx, hy, _] = r.base_half_extents;
+        let body = [[hx, hy], [hx, -hy], [-hx, hy], [-hx, -hy]]
+            .into_iter()
+            .chain(r.hips.iter().map(|h| [h[0], h[1]]))
+            .map(world);
+        let r_body = self.config.motion.max_base_shift_m + r.thigh_length + margin;
+        let r_foot = r.foot_length + r.wheel_track / 2.0 + r.wheel_radius + margin;
+        let feet_xy = feet.pos.into_iter().chain([[foothold[0], foothold[1]]]);
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for (p, grow) in feet_xy.map(|p| (p, r_foot)).chain(body.map(|p| (p, r_body))) {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k] - grow);
+                hi[k] = hi[k].max(p[k] + grow);
+            }
+        }
+        let origin = self.maps.heights().origin();
+        let cell = |v: f64, k: usize| ((v - origin[k]) / res).floor() as i64;
+        let (i0, i1) = (cell(lo[0], 0), cell(hi[0], 0));
+        let (j0, j1) = (cell(lo[1], 1), cell(hi[1], 1));
+        let print = prints.print([i0, i1], [j0, j1])?;
+        let (si, sj) = (i64::from(s.i), i64::from(s.j));
+        let rel = [i0 - si, i1 - si, j0 - sj, j1 - sj].map(|d| d as i16);
+        Some((print, rel, s.theta, *o, leg as u8, to))
     }
 
     /// The footholds of `leg`'s step by the scan alone (C_S, offset change, cost terms,

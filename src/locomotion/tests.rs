@@ -802,6 +802,61 @@ mod hybrid {
     }
 
     #[test]
+    fn translated_step_failures_turn_away_only_steps_that_fail() {
+        // A straight drop, 0.3 m (the step-down scenario's) for y < 0 and 0.2 m beyond,
+        // and a 0.2 m strip across the floor further on: from stances along the drop,
+        // before and after the descent shift, and before the strip, at two headings, the
+        // steps offered with failed checks taken over from other cells are those the
+        // checks give alone; some are taken over, each where the check fails. Front steps
+        // down 0.3 m fail from stances that step down 0.2 m: without the terrain's print
+        // in the key, the first would turn the second away.
+        let prims = [
+            Primitive::Box { center: [-0.25, -1.5], size: [2.5, 3.0], height: 0.3, yaw_deg: 0.0 },
+            Primitive::Box { center: [-0.25, 1.5], size: [2.5, 3.0], height: 0.2, yaw_deg: 0.0 },
+            Primitive::Box { center: [2.6, 0.0], size: [0.4, 6.0], height: 0.2, yaw_deg: 0.0 },
+        ];
+        let m = rasterise(&prims, [-1.5, -3.0], [6.0, 6.0], 0.025).expect("map");
+        let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
+        let goal = state_on(&maps, 3.4, 0.0, 0.0);
+        let new_graph = |reuse: bool| {
+            let cfg = HybridConfig { reuse_translated_step_failures: reuse, ..config() };
+            HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal)).expect("graph")
+        };
+        let (mut reusing, mut checking) = (new_graph(true), new_graph(false));
+        let mut steps = 0;
+        for (x, yaw) in [(0.45, 0.0), (0.45, 0.4), (1.9, 0.0)] {
+            for k in -20..=12 {
+                let s = state_on(&maps, x, f64::from(k) * 0.1, yaw);
+                let mut from = vec![s];
+                from.extend(
+                    checking
+                        .labelled_successors(s)
+                        .into_iter()
+                        .filter(|(_, _, m)| m.kind == ManoeuvreKind::BaseShift)
+                        .map(|(t, _, _)| t),
+                );
+                for t in from {
+                    let want = step_edges(&mut checking, t);
+                    assert_eq!(step_edges(&mut reusing, t), want, "from {t:?}");
+                    steps += want.len();
+                }
+            }
+        }
+        let (reused, checked) = (reusing.stats(), checking.stats());
+        assert_eq!(checked.step_failures_translated, 0);
+        assert!(reused.step_failures_translated > 10, "{reused:?}");
+        assert!(steps > 0, "no step offered at all");
+        assert_eq!(reused.step_checks_passed, checked.step_checks_passed);
+        let failed = |c: ManoeuvreStats| {
+            c.front_steps_unstable
+                + c.rear_steps_unstable
+                + c.steps_without_leg_height
+                + c.steps_failed_otherwise
+        };
+        assert_eq!(failed(reused) + reused.step_failures_translated, failed(checked));
+    }
+
+    #[test]
     fn descends_a_flight_with_the_descent_shift_mid_flight() {
         // Three 0.20 m rises on 0.25 m treads, walked down head-on (stairs step model,
         // wheel-pair feet, as `momaro envelope stairs` plans them). Stop 27 restricted
