@@ -122,6 +122,9 @@ pub struct CostMaps {
     neutral_footprint: [[f64; 2]; 4],
     driving_leg_height: f64,
     unknown_heights: usize,
+    /// The translation-invariant prints of these layers ([`Self::prints`]), built at the
+    /// first request and shared by every graph on the map (a replan's graph too).
+    prints: std::sync::OnceLock<prints::TerrainPrints>,
 }
 
 impl CostMaps {
@@ -187,7 +190,15 @@ impl CostMaps {
             neutral_footprint: robot.neutral_footprint(),
             driving_leg_height: params.driving_leg_height_m,
             unknown_heights: map.len() - map.known_count(),
+            prints: std::sync::OnceLock::new(),
         })
+    }
+
+    /// The layers' translation-invariant prints ([`prints::TerrainPrints`]), padded by
+    /// `pad` cells at the first request. A later request gets the same prints: any padding
+    /// is correct (a rectangle beyond it has no print), only smaller windows fit.
+    pub fn prints(&self, pad: usize) -> &prints::TerrainPrints {
+        self.prints.get_or_init(|| prints::TerrainPrints::new(self, pad))
     }
 
     /// A signature of everything the layers hold at cell (i, j) of the map (heights, leg

@@ -71,6 +71,7 @@ fn mix(h: u64, bits: u64) -> u64 {
 }
 
 /// One lane: prefix sums and the inverse powers of its bases.
+#[derive(Clone)]
 struct Lane {
     /// `(w + 1) × (h + 1)` row-major: the sum over cells `[0, i) × [0, j)` (padded
     /// coordinates) of `v · a^i · b^j`.
@@ -80,6 +81,7 @@ struct Lane {
 }
 
 /// Translation-invariant rectangle prints of one [`CostMaps`] (module docs).
+#[derive(Clone)]
 pub struct TerrainPrints {
     /// Off-map cells kept on every side, cells.
     pad: usize,

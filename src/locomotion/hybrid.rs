@@ -180,7 +180,6 @@ use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{STEP_HEIGHT_TOLERANCE_M, StepBound, StepBoundParams, offsets_weighed};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use super::reachability::{BaseRegions, StanceLimits};
-use crate::cost::prints::TerrainPrints;
 use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
@@ -557,8 +556,6 @@ pub struct HybridGraph<'c> {
     /// The failed step checks by what they read and did, wherever they stood (module
     /// docs, "Translated step failures").
     translated_failures: HashSet<TranslatedStep, FxBuild>,
-    /// The maps' translation-invariant prints, built at the first step check.
-    prints: OnceCell<TerrainPrints>,
     /// [`Self::wheel_segment_ok`] by the pose and footprint a one-cell wheel move starts
     /// from, the leg and its new offset.
     wheel_move_checks: HashMap<(PoseKey, u8, i8), bool, FxBuild>,
@@ -766,7 +763,6 @@ impl<'c> HybridGraph<'c> {
             base_shift_checks: HashMap::default(),
             step_checks: HashMap::default(),
             translated_failures: HashSet::default(),
-            prints: OnceCell::new(),
         })
     }
 
@@ -1470,12 +1466,11 @@ impl<'c> HybridGraph<'c> {
         let r = &self.robot;
         let res = self.lattice.resolution;
         let margin = TRANSLATION_WINDOW_MARGIN_M + 2.0 * res;
-        let prints = self.prints.get_or_init(|| {
-            let reach =
-                r.max_leg_length() + r.hips.iter().map(|h| h[0].hypot(h[1])).fold(0.0, f64::max);
-            let far = reach + self.config.motion.max_base_shift_m + r.wheel_track + margin;
-            TerrainPrints::new(self.maps, (far / res).ceil() as usize + 2)
-        });
+        // The prints' padding: the farthest a window reaches from its base cell.
+        let reach =
+            r.max_leg_length() + r.hips.iter().map(|h| h[0].hypot(h[1])).fold(0.0, f64::max);
+        let far = reach + self.config.motion.max_base_shift_m + r.wheel_track + margin;
+        let prints = self.maps.prints((far / res).ceil() as usize + 2);
         let pose = self.lattice.pose(s);
         let (sin, cos) = pose.theta.sin_cos();
         let world = |[x, y]: [f64; 2]| [pose.x + cos * x - sin * y, pose.y + sin * x + cos * y];
