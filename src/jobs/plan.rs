@@ -1283,9 +1283,9 @@ mod tests {
              2 rear steps with no stable motion, 1 otherwise"
         );
         let copied = ManoeuvreStats { step_failures_translated: 7, ..stats };
-        assert!(super::step_checks_said(&copied).ends_with(
-            "1 otherwise; 7 more steps turned away as copies of failed checks elsewhere"
-        ),);
+        let said = super::step_checks_said(&copied);
+        let copies = "1 otherwise; 7 more steps turned away as copies of failed checks elsewhere";
+        assert!(said.ends_with(copies), "{said}");
     }
 
     #[test]

@@ -1472,13 +1472,11 @@ impl<'c> HybridGraph<'c> {
         let far = reach + self.config.motion.max_base_shift_m + r.wheel_track + margin;
         let prints = self.maps.prints((far / res).ceil() as usize + 2);
         let pose = self.lattice.pose(s);
-        let (sin, cos) = pose.theta.sin_cos();
-        let world = |[x, y]: [f64; 2]| [pose.x + cos * x - sin * y, pose.y + sin * x + cos * y];
         let [hx, hy, _] = r.base_half_extents;
         let body = [[hx, hy], [hx, -hy], [-hx, hy], [-hx, -hy]]
             .into_iter()
             .chain(r.hips.iter().map(|h| [h[0], h[1]]))
-            .map(world);
+            .map(|p| pose.transform(p));
         let r_body = self.config.motion.max_base_shift_m + r.thigh_length + margin;
         let r_foot = r.foot_length + r.wheel_track / 2.0 + r.wheel_radius + margin;
         let feet_xy = feet.pos.into_iter().chain([[foothold[0], foothold[1]]]);
@@ -1490,10 +1488,9 @@ impl<'c> HybridGraph<'c> {
                 hi[k] = hi[k].max(p[k] + grow);
             }
         }
-        let origin = self.maps.heights().origin();
-        let cell = |v: f64, k: usize| ((v - origin[k]) / res).floor() as i64;
-        let (i0, i1) = (cell(lo[0], 0), cell(hi[0], 0));
-        let (j0, j1) = (cell(lo[1], 1), cell(hi[1], 1));
+        let cell =
+            |[x, y]: [f64; 2]| self.maps.heights().grid_coords(x, y).map(|g| g.floor() as i64);
+        let ([i0, j0], [i1, j1]) = (cell(lo), cell(hi));
         let print = prints.print([i0, i1], [j0, j1])?;
         let (si, sj) = (i64::from(s.i), i64::from(s.j));
         let rel = [i0 - si, i1 - si, j0 - sj, j1 - sj].map(|d| d as i16);
