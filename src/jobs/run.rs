@@ -847,7 +847,7 @@ pub fn execute(
         sum_track += track;
         n_track += 1;
         max_pitch = max_pitch.max(sim.base().rpy[1].abs());
-        if let Some(r) = &recorder
+        if let Some(r) = &mut recorder
             && tick.is_multiple_of(4)
         {
             r.log_bodies(sim.time(), &sim.body_poses())?;

@@ -171,7 +171,7 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
         sim.step(substeps)?;
         tick += 1;
         let sample = monitor.observe(&sim);
-        if let Some(r) = &recorder
+        if let Some(r) = &mut recorder
             && tick.is_multiple_of(record_every)
         {
             r.log_bodies(sim.time(), &sim.body_poses())?;

@@ -6,6 +6,10 @@
 //! - `world/stability/com` (CoM projected on the ground), `world/stability/support_polygon`;
 //! - `plots/stability_margin_m`: the margin as a time series;
 //! - `world/plan/...` and `maps/...`: plans and cost layers, where a job logs them.
+//!
+//! The per-frame series (bodies, stability overlay, trajectory, plots) are buffered
+//! ([`Pending`]) and sent as columns; they carry the `sim_time` timeline only (no
+//! `log_tick` or `log_time`: a `log` call per sample was a quarter of a run's wall time).
 
 use crate::cost_image::RgbImage;
 use crate::geometry::Pose2;
@@ -36,6 +40,8 @@ pub struct Recorder {
     rec: rerun::RecordingStream,
     path: PathBuf,
     body_names: Vec<String>,
+    /// Time series not yet sent (see [`Pending`]).
+    pending: Pending,
 }
 
 impl std::fmt::Debug for Recorder {
@@ -77,7 +83,7 @@ impl Recorder {
             .map_err(|e| VizError::Write { path: path.to_owned(), message: e.to_string() })?;
         rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())
             .map_err(|e| VizError::Write { path: path.to_owned(), message: e.to_string() })?;
-        Ok(Self { rec, path: path.to_owned(), body_names: Vec::new() })
+        Ok(Self { rec, path: path.to_owned(), body_names: Vec::new(), pending: Pending::default() })
     }
 
     fn err(&self, e: impl std::fmt::Display) -> VizError {
@@ -168,58 +174,38 @@ impl Recorder {
         Ok(())
     }
 
-    /// Logs the bodies' poses at simulated time `time`.
+    /// Logs the bodies' poses at simulated time `time` (buffered, see [`Pending`]).
     ///
     /// # Errors
-    /// [`VizError`] if writing fails.
-    pub fn log_bodies(&self, time: f64, bodies: &[BodyPose]) -> Result<(), VizError> {
-        self.rec.set_duration_secs(SIM_TIME, time);
-        for b in bodies {
-            let t =
-                rerun::Transform3D::from_translation_rotation(v3(b.position), quat(b.quaternion));
-            self.rec.log(format!("world/robot/{}", b.name), &t).map_err(|e| self.err(e))?;
+    /// [`VizError`] if writing a full buffer fails.
+    pub fn log_bodies(&mut self, time: f64, bodies: &[BodyPose]) -> Result<(), VizError> {
+        for (k, b) in bodies.iter().enumerate() {
+            let column = Column::find(&mut self.pending.bodies, k, &b.name);
+            column.push(time, (v3(b.position), b.quaternion));
         }
-        Ok(())
+        self.rows_logged(bodies.len())
     }
 
     /// Logs a stability sample: the CoM's ground projection, the support polygon and the
-    /// margin time series.
+    /// margin time series (buffered, see [`Pending`]).
     ///
     /// # Errors
-    /// [`VizError`] if writing fails.
-    pub fn log_stability(&self, s: &StabilitySample, ground_z: f64) -> Result<(), VizError> {
-        self.rec.set_duration_secs(SIM_TIME, s.time);
+    /// [`VizError`] if writing a full buffer fails.
+    pub fn log_stability(&mut self, s: &StabilitySample, ground_z: f64) -> Result<(), VizError> {
         let z = ground_z as f32 + 0.005;
-        let color = if s.margin > 0.0 {
-            rerun::Color::from_rgb(40, 200, 60)
-        } else {
-            rerun::Color::from_rgb(230, 40, 40)
-        };
-        self.rec
-            .log(
-                "world/stability/com",
-                &rerun::Points3D::new([[s.com[0] as f32, s.com[1] as f32, z], v3(s.com)])
-                    .with_radii([0.025])
-                    .with_colors([color]),
-            )
-            .map_err(|e| self.err(e))?;
+        let stable = s.margin > 0.0;
+        let com = [[s.com[0] as f32, s.com[1] as f32, z], v3(s.com)];
+        self.pending.com.push(s.time, (com, stable));
         let mut ring: Vec<[f32; 3]> =
             s.support_polygon.iter().map(|p| [p[0] as f32, p[1] as f32, z]).collect();
         if let Some(first) = ring.first().copied() {
             ring.push(first);
         }
-        self.rec
-            .log(
-                "world/stability/support_polygon",
-                &rerun::LineStrips3D::new([ring]).with_colors([color]),
-            )
-            .map_err(|e| self.err(e))?;
+        self.pending.support.push(s.time, (ring, stable));
         if s.margin.is_finite() {
-            self.rec
-                .log("plots/stability_margin_m", &rerun::Scalars::single(s.margin))
-                .map_err(|e| self.err(e))?;
+            Column::find(&mut self.pending.scalars, 0, "stability_margin_m").push(s.time, s.margin);
         }
-        Ok(())
+        self.rows_logged(3)
     }
 
     /// Logs the load on each leg's wheel pair (N) as time series under
@@ -227,23 +213,21 @@ impl Recorder {
     /// controllers (`control::load_sharing`) keep the diagonals near their share.
     ///
     /// # Errors
-    /// [`VizError`] if writing fails.
-    pub fn log_wheel_loads(&self, time: f64, loads: &[f64; 4]) -> Result<(), VizError> {
+    /// [`VizError`] if writing a full buffer fails.
+    pub fn log_wheel_loads(&mut self, time: f64, loads: &[f64; 4]) -> Result<(), VizError> {
         for (leg, load) in Leg::ALL.iter().zip(loads) {
             self.log_scalar(time, &format!("wheel_load_n/{}", leg.prefix()), *load)?;
         }
         Ok(())
     }
 
-    /// Logs a scalar time series value under `plots/<name>`.
+    /// Logs a scalar time series value under `plots/<name>` (buffered, see [`Pending`]).
     ///
     /// # Errors
-    /// [`VizError`] if writing fails.
-    pub fn log_scalar(&self, time: f64, name: &str, value: f64) -> Result<(), VizError> {
-        self.rec.set_duration_secs(SIM_TIME, time);
-        self.rec
-            .log(format!("plots/{name}"), &rerun::Scalars::single(value))
-            .map_err(|e| self.err(e))
+    /// [`VizError`] if writing a full buffer fails.
+    pub fn log_scalar(&mut self, time: f64, name: &str, value: f64) -> Result<(), VizError> {
+        Column::find(&mut self.pending.scalars, 0, name).push(time, value);
+        self.rows_logged(1)
     }
 
     /// Logs the known cells of a height map as a static point cloud under
@@ -370,28 +354,171 @@ impl Recorder {
             .map_err(|e| self.err(e))
     }
 
-    /// Appends the base position to the executed trajectory (`world/trajectory`).
+    /// Appends the base position to the executed trajectory (`world/trajectory`,
+    /// buffered, see [`Pending`]).
     ///
     /// # Errors
-    /// [`VizError`] if writing fails.
-    pub fn log_trajectory_point(&self, time: f64, position: [f64; 3]) -> Result<(), VizError> {
-        self.rec.set_duration_secs(SIM_TIME, time);
-        self.rec
-            .log(
-                "world/trajectory",
-                &rerun::Points3D::new([v3(position)])
-                    .with_radii([0.01])
-                    .with_colors([rerun::Color::from_rgb(230, 120, 20)]),
-            )
-            .map_err(|e| self.err(e))
+    /// [`VizError`] if writing a full buffer fails.
+    pub fn log_trajectory_point(&mut self, time: f64, position: [f64; 3]) -> Result<(), VizError> {
+        self.pending.trajectory.push(time, v3(position));
+        self.rows_logged(1)
     }
 
-    /// Flushes and closes the file.
+    /// Writes the buffered time series and flushes and closes the file.
     ///
     /// # Errors
     /// [`VizError`] if the final write fails.
-    pub fn finish(self) -> Result<(), VizError> {
+    pub fn finish(mut self) -> Result<(), VizError> {
+        self.send_pending()?;
         self.rec.flush_blocking().map_err(|e| self.err(e))
+    }
+
+    /// Counts `n` buffered rows; sends the buffers once they hold [`FLUSH_ROWS`].
+    fn rows_logged(&mut self, n: usize) -> Result<(), VizError> {
+        self.pending.rows += n;
+        if self.pending.rows >= FLUSH_ROWS { self.send_pending() } else { Ok(()) }
+    }
+
+    /// Sends every buffered time series as columns, one `send_columns` per entity, and
+    /// empties the buffers.
+    fn send_pending(&mut self) -> Result<(), VizError> {
+        let pending = std::mem::take(&mut self.pending);
+        for c in pending.bodies {
+            let (translations, rotations): (Vec<[f32; 3]>, Vec<rerun::Quaternion>) =
+                c.values.iter().map(|&(t, q)| (t, quat(q))).unzip();
+            let columns = rerun::Transform3D::update_fields()
+                .with_many_translation(translations)
+                .with_many_quaternion(rotations)
+                .columns_of_unit_batches();
+            self.send(&format!("world/robot/{}", c.entity), &c.times, columns)?;
+        }
+        for c in pending.scalars {
+            let columns = rerun::Scalars::update_fields()
+                .with_scalars(c.values.iter().copied())
+                .columns_of_unit_batches();
+            self.send(&format!("plots/{}", c.entity), &c.times, columns)?;
+        }
+        let com = &pending.com;
+        // Two points a row (on the ground, at the CoM) sharing one radius and colour, as
+        // `log` writes them: the positions partitioned by two, the rest by one.
+        let n = com.values.len();
+        let columns = rerun::Points3D::update_fields()
+            .with_positions(com.values.iter().flat_map(|(p, _)| *p))
+            .columns(std::iter::repeat_n(2, n))
+            .and_then(|points| {
+                let style = rerun::Points3D::update_fields()
+                    .with_radii(std::iter::repeat_n(0.025f32, n))
+                    .with_colors(com.values.iter().map(|&(_, stable)| margin_color(stable)))
+                    .columns_of_unit_batches()?;
+                Ok(points.chain(style))
+            });
+        self.send("world/stability/com", &com.times, columns)?;
+        let support = &pending.support;
+        let columns = rerun::LineStrips3D::update_fields()
+            .with_strips(support.values.iter().map(|(ring, _)| ring.clone()))
+            .with_colors(support.values.iter().map(|&(_, stable)| margin_color(stable)))
+            .columns_of_unit_batches();
+        self.send("world/stability/support_polygon", &support.times, columns)?;
+        let trajectory = &pending.trajectory;
+        let n = trajectory.values.len();
+        let columns = rerun::Points3D::update_fields()
+            .with_positions(trajectory.values.iter().copied())
+            .with_radii(std::iter::repeat_n(0.01f32, n))
+            .with_colors(std::iter::repeat_n(rerun::Color::from_rgb(230, 120, 20), n))
+            .columns_of_unit_batches();
+        self.send("world/trajectory", &trajectory.times, columns)
+    }
+
+    /// One `send_columns` of `columns` at `times` on the sim-time timeline (nothing for
+    /// no rows).
+    fn send<C>(
+        &self,
+        entity: &str,
+        times: &[f64],
+        columns: Result<C, rerun::SerializationError>,
+    ) -> Result<(), VizError>
+    where
+        C: IntoIterator<Item = rerun::SerializedComponentColumn>,
+    {
+        if times.is_empty() {
+            return Ok(());
+        }
+        let index = rerun::TimeColumn::new_duration_secs(SIM_TIME, times.iter().copied());
+        let columns = columns.map_err(|e| self.err(e))?;
+        self.rec.send_columns(entity, [index], columns).map_err(|e| self.err(e))
+    }
+}
+
+impl Drop for Recorder {
+    /// Sends what is still buffered, so that a job that stops on an error (without
+    /// [`Recorder::finish`]) keeps its time series; a write error here has no one to go to.
+    fn drop(&mut self) {
+        let _ = self.send_pending();
+    }
+}
+
+/// The colour of the stability overlay: green with a positive margin, else red.
+fn margin_color(stable: bool) -> rerun::Color {
+    if stable { rerun::Color::from_rgb(40, 200, 60) } else { rerun::Color::from_rgb(230, 40, 40) }
+}
+
+/// Samples buffered before they are sent: a frame of a run logged some 40 rows (a
+/// transform per body, the stability overlay, the plots), and a `log` call costs about
+/// 10 µs of the simulation thread plus the batcher's work on the other core; the
+/// platform's run took 7.2 s with a recording and 5.8 s without. Sent as columns
+/// (`send_columns`, a chunk per entity) every [`FLUSH_ROWS`] samples and at the end.
+#[derive(Debug, Default)]
+struct Pending {
+    /// Per body, in the order the simulation lists them, by body name.
+    bodies: Vec<Column<([f32; 3], [f64; 4])>>,
+    /// Per series, by name under `plots/`.
+    scalars: Vec<Column<f64>>,
+    /// The CoM on the ground and in space, and whether the margin was positive.
+    com: Column<([[f32; 3]; 2], bool)>,
+    /// The closed support polygon, and whether the margin was positive.
+    support: Column<(Vec<[f32; 3]>, bool)>,
+    /// The base positions.
+    trajectory: Column<[f32; 3]>,
+    /// Rows buffered since the last send.
+    rows: usize,
+}
+
+/// Rows buffered before a send: about 1,000 frames of a run (some 40 rows each), 40 s of
+/// simulated time at its recording rate of 25 Hz; a few MB.
+const FLUSH_ROWS: usize = 40_000;
+
+/// One entity's buffered samples: times (s) and values.
+#[derive(Debug)]
+struct Column<T> {
+    entity: String,
+    times: Vec<f64>,
+    values: Vec<T>,
+}
+
+impl<T> Default for Column<T> {
+    fn default() -> Self {
+        Self { entity: String::new(), times: Vec::new(), values: Vec::new() }
+    }
+}
+
+impl<T> Column<T> {
+    /// The column of `entity` in `columns`, tried at index `hint` first (the bodies come
+    /// in the same order every frame), added at the end if there is none.
+    fn find<'a>(columns: &'a mut Vec<Column<T>>, hint: usize, entity: &str) -> &'a mut Self {
+        let k = if columns.get(hint).is_some_and(|c| c.entity == entity) {
+            hint
+        } else if let Some(k) = columns.iter().position(|c| c.entity == entity) {
+            k
+        } else {
+            columns.push(Column { entity: entity.to_owned(), ..Column::default() });
+            columns.len() - 1
+        };
+        &mut columns[k]
+    }
+
+    fn push(&mut self, time: f64, value: T) {
+        self.times.push(time);
+        self.values.push(value);
     }
 }
 
@@ -476,5 +603,101 @@ impl Recorder {
                 .map_err(|e| self.err(e))?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+
+    /// A recorder writing to memory instead of a file.
+    fn in_memory() -> (Recorder, rerun::sink::MemorySinkStorage) {
+        let (rec, storage) =
+            rerun::RecordingStreamBuilder::new("momaro test").memory().expect("memory sink");
+        let r = Recorder {
+            rec,
+            path: PathBuf::from("memory"),
+            body_names: Vec::new(),
+            pending: Pending::default(),
+        };
+        (r, storage)
+    }
+
+    /// Rows per entity of everything the stream wrote.
+    fn rows(storage: &rerun::sink::MemorySinkStorage) -> BTreeMap<String, usize> {
+        let mut rows = BTreeMap::new();
+        for msg in storage.take() {
+            if let rerun::log::LogMsg::ArrowMsg(_, arrow) = msg {
+                let chunk = rerun::log::Chunk::from_arrow_msg(&arrow).expect("chunk");
+                *rows.entry(chunk.entity_path().to_string()).or_default() += chunk.num_rows();
+            }
+        }
+        rows
+    }
+
+    fn body(name: &str, x: f64) -> BodyPose {
+        BodyPose {
+            name: name.to_owned(),
+            position: [x, 0.0, 0.5],
+            quaternion: [1.0, 0.0, 0.0, 0.0],
+        }
+    }
+
+    fn sample(time: f64, margin: f64) -> StabilitySample {
+        StabilitySample {
+            time,
+            com: [0.0, 0.0, 0.6],
+            contacts: Vec::new(),
+            support_polygon: vec![[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]],
+            margin,
+            roll_pitch: [0.0; 2],
+            vertical_speed: 0.0,
+            body_collisions: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn every_buffered_frame_is_written_when_the_recording_finishes() {
+        let (mut r, storage) = in_memory();
+        for k in 0..30 {
+            let t = f64::from(k) * 0.04;
+            r.log_bodies(t, &[body("base", t), body("fl_wheel_l", t)]).expect("bodies");
+            r.log_stability(&sample(t, if k == 3 { f64::NEG_INFINITY } else { 0.1 }), 0.0)
+                .expect("stability");
+            r.log_trajectory_point(t, [t, 0.0, 0.5]).expect("trajectory");
+            r.log_wheel_loads(t, &[100.0; 4]).expect("loads");
+        }
+        r.finish().expect("finish");
+        let rows = rows(&storage);
+        for entity in [
+            "/world/robot/base",
+            "/world/robot/fl_wheel_l",
+            "/world/stability/com",
+            "/world/stability/support_polygon",
+            "/world/trajectory",
+            "/plots/wheel_load_n/fl",
+            "/plots/wheel_load_n/rr",
+        ] {
+            assert_eq!(rows.get(entity), Some(&30), "{entity}: {rows:?}");
+        }
+        // No margin where no wheel supports the robot (−∞).
+        assert_eq!(rows.get("/plots/stability_margin_m"), Some(&29), "{rows:?}");
+    }
+
+    #[test]
+    fn a_recording_dropped_without_finish_keeps_what_it_buffered_past_a_flush() {
+        let (mut r, storage) = in_memory();
+        // Two bodies a frame: the buffers are sent once on the way (FLUSH_ROWS) and the
+        // rest when the recorder is dropped, as a job that stops on an error drops it.
+        let frames = FLUSH_ROWS / 2 + 7;
+        for k in 0..frames {
+            let t = k as f64 * 0.04;
+            r.log_bodies(t, &[body("base", t), body("fl_thigh", t)]).expect("bodies");
+        }
+        drop(r);
+        let rows = rows(&storage);
+        assert_eq!(rows.get("/world/robot/base"), Some(&frames), "{rows:?}");
+        assert_eq!(rows.get("/world/robot/fl_thigh"), Some(&frames), "{rows:?}");
     }
 }
