@@ -30,6 +30,11 @@ use crate::robot::RobotDescription;
 use crate::robot::ik::{LegChain, knee_and_ankle, leg_fk};
 use crate::terrain::HeightMap;
 
+/// Pad of a leg chain's bounding box in [`StandingRule::legs_clear`]'s block test, in
+/// grid cells and metres: far above the rounding of a sample interpolated between two of
+/// the chain's points (about 10⁻¹⁵), far below anything a cell or a clearance resolves.
+const CHAIN_BOX_PAD: f64 = 1e-9;
+
 /// The parameters of the rule.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StandingRule {
@@ -144,6 +149,24 @@ impl StandingRule {
                 let [gx, gy] = terrain.grid_coords(w[0], w[1]);
                 [gx, gy, w[2]]
             });
+            // Every sample lies in the chain's bounding box and no lower than its lowest
+            // point (the segments are straight): a leg whose lowest point keeps the
+            // clearance above the box's highest block keeps it at every sample, and is
+            // clear without them (a few block look-ups where the samples take 8; the
+            // result is the same, the pads cover the interpolation's rounding).
+            let (lo, hi) =
+                chain.iter().fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| {
+                    (
+                        std::array::from_fn(|c| lo[c].min(p[c])),
+                        std::array::from_fn(|c| hi[c].max(p[c])),
+                    )
+                });
+            let pad = CHAIN_BOX_PAD;
+            let top = terrain
+                .max_known_in_grid_box([lo[0] - pad, lo[1] - pad], [hi[0] + pad, hi[1] + pad]);
+            if lo[2] - pad - top >= self.leg_clearance_m {
+                continue;
+            }
             for seg in chain.windows(2) {
                 // A quarter segment apart, far end included (the hip never dips).
                 for k in 1..=4 {

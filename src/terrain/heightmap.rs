@@ -17,6 +17,8 @@
 //! What a cell's height means depends on the source: see `rasterise` (highest surface
 //! over the cell's area) and `sensed` (highest up-facing laser return in the cell).
 
+use std::sync::OnceLock;
+
 /// Why a height map (or a view of one) could not be made or changed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HeightMapError {
@@ -79,13 +81,55 @@ pub enum HeightMapError {
 
 /// A regular grid of terrain heights (m), `NaN` = unknown. See the module doc for the
 /// frame convention.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct HeightMap {
     origin: [f64; 2],
     resolution: f64,
     nx: usize,
     ny: usize,
     data: Vec<f64>,
+    /// The blocks' highest heights, made by the first [`HeightMap::max_known_in_grid_box`]
+    /// and dropped by every change to `data`.
+    blocks: OnceLock<BlockMax>,
+}
+
+impl PartialEq for HeightMap {
+    /// The same grid and heights (the block cache does not count).
+    fn eq(&self, other: &Self) -> bool {
+        self.origin == other.origin
+            && self.resolution == other.resolution
+            && (self.nx, self.ny) == (other.nx, other.ny)
+            && self.data == other.data
+    }
+}
+
+/// Cells along each side of a block of [`BlockMax`]: 20 cm at the planner's 2.5 cm, about
+/// the reach of a leg segment.
+const BLOCK: usize = 8;
+
+/// The highest known height of each block of [`BLOCK`] × [`BLOCK`] cells (−∞ where
+/// none is known), row-major like the cells.
+#[derive(Debug, Clone)]
+struct BlockMax {
+    bx: usize,
+    max: Vec<f64>,
+}
+
+impl BlockMax {
+    fn build(map: &HeightMap) -> Self {
+        let bx = map.nx.div_ceil(BLOCK);
+        let by = map.ny.div_ceil(BLOCK);
+        let mut max = vec![f64::NEG_INFINITY; bx * by];
+        for j in 0..map.ny {
+            let row = &map.data[j * map.nx..(j + 1) * map.nx];
+            let out = &mut max[(j / BLOCK) * bx..(j / BLOCK + 1) * bx];
+            for (b, cells) in row.chunks(BLOCK).enumerate() {
+                // `f64::max` passes over NaN: unknown cells never count.
+                out[b] = cells.iter().copied().fold(out[b], f64::max);
+            }
+        }
+        Self { bx, max }
+    }
 }
 
 fn check_geometry(
@@ -126,7 +170,7 @@ impl HeightMap {
         if let Some(k) = data.iter().position(|v| v.is_infinite()) {
             return Err(HeightMapError::InfiniteHeight { i: k % nx, j: k / nx, value: data[k] });
         }
-        Ok(Self { origin, resolution, nx, ny, data })
+        Ok(Self { origin, resolution, nx, ny, data, blocks: OnceLock::new() })
     }
 
     /// A map with every cell at `value` (`NaN` for an all-unknown map).
@@ -144,7 +188,8 @@ impl HeightMap {
         if value.is_infinite() {
             return Err(HeightMapError::InfiniteHeight { i: 0, j: 0, value });
         }
-        Ok(Self { origin, resolution, nx, ny, data: vec![value; nx * ny] })
+        let data = vec![value; nx * ny];
+        Ok(Self { origin, resolution, nx, ny, data, blocks: OnceLock::new() })
     }
 
     /// A map with every cell unknown.
@@ -262,6 +307,34 @@ impl HeightMap {
         self.get(i, j)
     }
 
+    /// An upper bound on the known heights of the cells holding a point of the box from
+    /// `lo` to `hi` in grid coordinates ([`Self::grid_coords`]) that lies on the map: the
+    /// highest height of the blocks of 8 × 8 cells the box touches (−∞ where none is
+    /// known or the box is off the map; +∞, no bound, for a NaN corner). One look-up per
+    /// block, where asking every point costs one per point: a body part that keeps its
+    /// clearance above this bound keeps it above every cell it passes.
+    #[inline]
+    pub fn max_known_in_grid_box(&self, lo: [f64; 2], hi: [f64; 2]) -> f64 {
+        if !(lo[0] <= hi[0] && lo[1] <= hi[1]) {
+            return f64::INFINITY;
+        }
+        let (nx, ny) = (self.nx as f64, self.ny as f64);
+        if hi[0] < 0.0 || hi[1] < 0.0 || lo[0] >= nx || lo[1] >= ny {
+            return f64::NEG_INFINITY;
+        }
+        // On [0, n) the truncating cast is floor; the box is clipped to the map.
+        let cell = |v: f64, n: usize| (v.max(0.0) as usize).min(n - 1);
+        let (i0, i1) = (cell(lo[0], self.nx) / BLOCK, cell(hi[0], self.nx) / BLOCK);
+        let (j0, j1) = (cell(lo[1], self.ny) / BLOCK, cell(hi[1], self.ny) / BLOCK);
+        let blocks = self.blocks.get_or_init(|| BlockMax::build(self));
+        let mut best = f64::NEG_INFINITY;
+        for bj in j0..=j1 {
+            let row = &blocks.max[bj * blocks.bx..];
+            best = row[i0..=i1].iter().copied().fold(best, f64::max);
+        }
+        best
+    }
+
     /// World position of the centre of cell (i, j), m. Defined for any index, also
     /// outside the map.
     #[inline]
@@ -316,6 +389,7 @@ impl HeightMap {
             ny: self.ny,
         })?;
         self.data[k] = value;
+        self.blocks = OnceLock::new();
         Ok(())
     }
 
@@ -345,6 +419,7 @@ impl HeightMap {
             }
         }
         let mut out = self.clone();
+        out.blocks = OnceLock::new();
         for j in 0..ny {
             let (a, b) = (j.saturating_sub(r), (j + r).min(ny - 1));
             for i in 0..nx {
@@ -889,5 +964,77 @@ mod tests {
         assert!(m.view(2, 0, 3, 1).is_err());
         assert!(m.view(0, 0, 0, 1).is_err());
         assert!(m.view(usize::MAX, 0, 2, 1).is_err());
+    }
+
+    /// The highest known height of the cells holding a point of the grid box, one by one.
+    fn max_known_per_cell(hm: &HeightMap, lo: [f64; 2], hi: [f64; 2]) -> f64 {
+        let (nx, ny) = hm.dims();
+        let mut best = f64::NEG_INFINITY;
+        for j in 0..ny {
+            for i in 0..nx {
+                let (x, y) = (i as f64, j as f64);
+                let touched = x + 1.0 > lo[0] && x <= hi[0] && y + 1.0 > lo[1] && y <= hi[1];
+                if touched && let Some(h) = hm.get(i, j) {
+                    best = best.max(h);
+                }
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn max_known_in_grid_box_takes_the_blocks_the_box_touches() {
+        // 20 x 10 cells: blocks of 8 x 8 are x 0-7, 8-15, 16-19 and y 0-7, 8-9.
+        let mut hm = HeightMap::filled([0.0, 0.0], 0.1, 20, 10, 0.0).unwrap();
+        hm.set(9, 2, 0.5).unwrap(); // block (1, 0)
+        hm.set(18, 9, 0.7).unwrap(); // block (2, 1)
+        hm.set(3, 3, f64::NAN).unwrap(); // unknown: never counts
+        // Within block (0, 0): its cells are 0 (the NaN passed over).
+        assert_eq!(hm.max_known_in_grid_box([0.5, 0.5], [7.9, 7.9]), 0.0);
+        // Touching x = 8 reaches block (1, 0) and its 0.5, though the cell is at x = 9:
+        // an upper bound, not the cells' maximum.
+        assert_eq!(hm.max_known_in_grid_box([7.5, 0.5], [8.0, 1.0]), 0.5);
+        // Clipped to the map: past its far corner, block (2, 1).
+        assert_eq!(hm.max_known_in_grid_box([17.0, 8.5], [40.0, 30.0]), 0.7);
+        // Off the map: nothing known; a NaN corner: no bound.
+        assert_eq!(hm.max_known_in_grid_box([-5.0, -5.0], [-0.1, 3.0]), f64::NEG_INFINITY);
+        assert_eq!(hm.max_known_in_grid_box([20.0, 0.0], [25.0, 3.0]), f64::NEG_INFINITY);
+        assert_eq!(hm.max_known_in_grid_box([f64::NAN, 0.0], [1.0, 1.0]), f64::INFINITY);
+        // A change after a query is seen (the blocks are made again), in a dilated map
+        // too (its blocks are its own, not a copy of the source's).
+        hm.set(7, 5, 0.6).unwrap();
+        assert_eq!(hm.max_known_in_grid_box([0.5, 0.5], [1.0, 1.0]), 0.6);
+        assert_eq!(hm.max_known_in_grid_box([10.0, 0.0], [10.5, 0.5]), 0.5);
+        // Dilated by a cell, the 0.6 at x = 7 reaches x = 8, into block (1, 0).
+        let wide = hm.dilated_max(1);
+        assert_eq!(wide.max_known_in_grid_box([10.0, 0.0], [10.5, 0.5]), 0.6);
+    }
+
+    proptest::proptest! {
+        /// The block bound is never below a known cell the box touches, and never above
+        /// the highest known height of the blocks around it (a box within one block
+        /// gets that block's maximum exactly).
+        #[test]
+        fn max_known_in_grid_box_bounds_every_touched_cell(
+            lo in proptest::array::uniform2(-3.0f64..23.0),
+            size in proptest::array::uniform2(0.0f64..12.0),
+            seed in 0u64..1000,
+        ) {
+            let hm = HeightMap::from_fn([0.0, 0.0], 0.05, 20, 20, |i, j| {
+                let v = ((i * 31 + j * 17) as u64 * 2654435761 + seed) % 1000;
+                if v < 50 { f64::NAN } else { v as f64 * 1e-3 }
+            })
+            .unwrap();
+            let hi = [lo[0] + size[0], lo[1] + size[1]];
+            let got = hm.max_known_in_grid_box(lo, hi);
+            proptest::prop_assert!(got >= max_known_per_cell(&hm, lo, hi));
+            let block = |v: f64| (v.clamp(0.0, 19.0) as usize / BLOCK * BLOCK) as f64;
+            let (blo, bhi) = ([block(lo[0]), block(lo[1])], [block(hi[0]) + 7.5, block(hi[1]) + 7.5]);
+            if hi[0] >= 0.0 && hi[1] >= 0.0 && lo[0] < 20.0 && lo[1] < 20.0 {
+                proptest::prop_assert_eq!(got, max_known_per_cell(&hm, blo, bhi));
+            } else {
+                proptest::prop_assert_eq!(got, f64::NEG_INFINITY);
+            }
+        }
     }
 }
