@@ -540,3 +540,23 @@ fn the_probe_steps_down_0_3_m_without_first_searching_the_whole_platform() {
     assert!((1.0..=50.0).contains(&probe.suboptimality_bound));
     assert_eq!(steps(&p).len(), 4, "every foot steps down once");
 }
+
+/// The feet's way over climbable terrain in the probe's greedy list (`locomotion::way`): on
+/// a generated flight with open sides (`generate --class stairs --seed 9`, CI's
+/// `stairs_000009`: 5 × 0.176 m at −56.5°, a landing after step 3) the probe's first two
+/// steps went up at headings from which the third fails, and its lists, the greedy one
+/// counting the straight line to the goal, then searched the floor beside the flight,
+/// nearer the goal than its foot, at every heading and footprint: 396 k expansions before
+/// the one pose at the foot from which the climb goes through. With the way the feet
+/// must go (back to the flight's foot, then up it) in the greedy list, 93 k.
+#[test]
+fn the_probe_climbs_a_flight_whose_side_lies_nearer_the_goal_than_its_foot() {
+    let s = common::generated(momaro::scenario::generate::Class::Stairs, 9);
+    let probe_only = PlanOptions { max_expansions: Some(150_000), ..probe_path() };
+    let p = plan(&s, &probe_only);
+    let probe = &p.solutions[0];
+    assert_eq!(probe.epsilon, 50.0);
+    assert!(probe.expansions < 120_000, "{} expansions", probe.expansions);
+    assert!((1.0..=50.0).contains(&probe.suboptimality_bound), "{}", probe.suboptimality_bound);
+    assert!(steps(&p).len() >= 20, "every foot climbs five steps: {}", steps(&p).len());
+}

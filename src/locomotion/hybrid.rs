@@ -175,11 +175,14 @@
 //! on random walks over random small maps, and that A*'s optimum does not change.
 
 use super::cost_to_go::CostToGo;
-use super::driving::{DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, edge_cost};
+use super::driving::{
+    DrivingConfig, DrivingGoal, DrivingGraph, PoseCostSource, edge_cost, heuristic_cost,
+};
 use super::footprint::{FootOffsets, FootprintTable, NEUTRAL_OFFSETS};
 use super::heuristic::{STEP_HEIGHT_TOLERANCE_M, StepBound, StepBoundParams, offsets_weighed};
 use super::lattice::{Lattice, LatticeError, LatticeState, NEUTRAL_FOOTPRINT, Neighbourhood};
 use super::reachability::{BaseRegions, StanceLimits};
+use super::way::WayField;
 use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
@@ -470,6 +473,9 @@ struct HeuristicTables {
     /// The driving and base-shift part (`cost_to_go`): a backward Dijkstra over base
     /// cells, run lazily as far as the queries need.
     cost_to_go: CostToGo,
+    /// The feet's way to the goal over terrain they could climb (`way`): the greedy
+    /// list's distance where it exceeds the straight line.
+    way: WayField,
     /// Time spent building the step bound and the regions.
     setup: Duration,
 }
@@ -586,6 +592,10 @@ pub struct HeuristicParts {
     /// The greedy list's share for feet ahead of neutral, [`GREEDY_OFFSET_PER_M`] · Σ o⁺
     /// (subtracted).
     pub greedy_ahead: Cost,
+    /// The feet's mean way to the goal over terrain they could climb, one per metre like
+    /// the straight line, plus the same turn as `driving` (`way`; zero where unknown): the
+    /// greedy list takes the larger of the two.
+    pub way: Cost,
 }
 
 /// The weight of each foot's offset from neutral, per metre, in the estimate that orders
@@ -630,11 +640,18 @@ impl HeuristicParts {
     }
 
     /// The estimate of the probe's greedy list (`SearchGraph::heuristic_and_guidances`):
-    /// [`Self::guidance`] with the feet's offsets weighed at [`GREEDY_OFFSET_PER_M`],
-    /// `driving + steps + greedy_behind − greedy_ahead`.
+    /// [`Self::guidance`] with the feet's offsets weighed at [`GREEDY_OFFSET_PER_M`] and
+    /// the straight line replaced by the feet's way where that is longer,
+    /// `max(driving, way) + steps + greedy_behind − greedy_ahead`. The straight line
+    /// misleads where the goal lies beyond a climb: beside a flight's top the floor is
+    /// nearer the goal than the flight's foot, and a probe stuck at the foot searched that
+    /// floor at every heading first. The feet's way (`way` module) goes back to the foot
+    /// and up the flight. Not admissible (a foot carried over a ledge by a step goes
+    /// less far than its way), and not meant to be: ε′ comes from [`Self::total`].
     pub fn greedy_guidance(&self) -> Cost {
         let without = Self {
             to_go: Cost::ZERO,
+            driving: self.driving.max(self.way),
             behind: self.greedy_behind,
             ahead: self.greedy_ahead,
             ..*self
@@ -841,7 +858,11 @@ impl<'c> HybridGraph<'c> {
             (config.motion.base_circle_radius_m, &self.stance_limits(), &step_bound),
             (goal.i, goal.j),
         );
-        HeuristicTables { regions, step_bound, cost_to_go, setup: t0.elapsed() }
+        let goal_feet = goal_feet(self.maps, &self.lattice, goal);
+        let goal_points: Vec<[f64; 2]> = goal_feet.iter().flatten().copied().collect();
+        let max_rise = config.max_step_height_m + STEP_HEIGHT_TOLERANCE_M;
+        let way = WayField::build(self.maps.heights(), &goal_points, max_rise);
+        HeuristicTables { regions, step_bound, cost_to_go, way, setup: t0.elapsed() }
     }
 
     /// How high any state's hips and base stand above its feet (`reachability`): the
@@ -909,6 +930,7 @@ impl<'c> HybridGraph<'c> {
             ahead: Cost::ZERO,
             greedy_behind: Cost::ZERO,
             greedy_ahead: Cost::ZERO,
+            way: Cost::ZERO,
         };
         let tables = self.tables();
         if !tables.regions.reachable(s.i, s.j) {
@@ -920,6 +942,9 @@ impl<'c> HybridGraph<'c> {
             p.steps = tables.step_bound.lower_bound(self.maps, feet);
             (p.behind, p.ahead) = tables.step_bound.offset_potential(o);
             (p.greedy_behind, p.greedy_ahead) = offsets_weighed(o, self.greedy_offset_per_cell);
+            p.way = tables.way.mean_of(feet).map_or(Cost::ZERO, |w| {
+                heuristic_cost(w).saturating_add(self.driving.turn_heuristic(s))
+            });
         }
         if p.steps.is_infinite() {
             // No chain of steps reaches the goal: the cost-to-go need not be searched.
@@ -2194,15 +2219,19 @@ fn build_step_bound(
         k10: config.k10,
         k11: config.k11,
     };
+    StepBound::build(maps, near, &params, &goal_feet(maps, lattice, goal))
+}
+
+/// The neutral feet of the goal pose, one array of four per goal orientation accepted.
+fn goal_feet(maps: &CostMaps, lattice: &Lattice, goal: DrivingGoal) -> Vec<[[f64; 2]; 4]> {
     let thetas: Vec<u8> = match goal.theta {
         Some(t) => vec![t],
         None => (0..lattice.orientations).map(|k| k as u8).collect(),
     };
-    let goal_feet: Vec<[[f64; 2]; 4]> = thetas
+    thetas
         .into_iter()
         .map(|theta| maps.neutral_feet(&lattice.pose(LatticeState::new(goal.i, goal.j, theta))))
-        .collect();
-    StepBound::build(maps, near, &params, &goal_feet)
+        .collect()
 }
 
 /// The criterion-1 pre-filter: per cell, whether an infinite-foot-cost cell's centre lies

@@ -17,6 +17,9 @@
 //! - [`reachability`]: base cells where the body and legs fit at all, and their
 //!   connected regions: states outside the goal's region get an infinite heuristic, so
 //!   closed rooms and doorways narrower than the robot are "no path" at once.
+//! - [`way`]: how far the feet still have to go over terrain they could climb (no rise
+//!   or drop between neighbouring cells beyond a step): the probe's greedy list counts it
+//!   where it is longer than the straight line; not a bound.
 //! - [`hybrid`]: the full hybrid graph — driving plus abstract steps, base shifts and
 //!   single-foot moves (Sec. V), with their costs C_S (eq. 5), C_BS and C_FM (eq. 6).
 
@@ -28,6 +31,7 @@ pub mod hybrid;
 pub mod lattice;
 pub mod orientation;
 pub mod reachability;
+pub mod way;
 
 #[cfg(test)]
 mod tests;

@@ -1366,7 +1366,8 @@ mod hybrid {
 }
 
 #[test]
-fn the_probes_guidance_is_the_heuristic_without_its_cost_to_go() {
+fn the_probes_guidance_is_the_heuristic_without_its_cost_to_go_and_its_greedy_one_counts_the_feet_way()
+ {
     // h = max(2, 15) + 30 + 1 − 0.5 = 45.5; guidance = 2 + 30 + 1 − 0.5 = 32.5; the
     // greedy list's = 2 + 30 + 0.25 − 0.125 = 32.125 (the offsets at its own weight).
     let u = |v: f64| Cost::from_f64(v);
@@ -1379,10 +1380,17 @@ fn the_probes_guidance_is_the_heuristic_without_its_cost_to_go() {
         ahead: u(0.5),
         greedy_behind: u(0.25),
         greedy_ahead: u(0.125),
+        way: u(1.5),
     };
     assert_eq!(p.total(), u(45.5));
     assert_eq!((p.guidance(), p.greedy_guidance()), (u(32.5), u(32.125)));
-    // Never above the heuristic; clamped at zero; infinite where the base cannot reach.
+    // The feet's way over climbable terrain replaces the straight line where it is longer,
+    // in the greedy list only (9 + 30 + 0.25 − 0.125), and leaves the heuristic and the
+    // weighted guidance alone.
+    let around = HeuristicParts { way: u(9.0), ..p };
+    assert_eq!(around.total(), u(45.5));
+    assert_eq!((around.guidance(), around.greedy_guidance()), (u(32.5), u(39.125)));
+    // Clamped at zero; infinite where the base cannot reach.
     let ahead = HeuristicParts { ahead: u(40.0), greedy_ahead: u(40.0), ..p };
     assert_eq!((ahead.total(), ahead.guidance()), (u(6.0), Cost::ZERO));
     assert_eq!(ahead.greedy_guidance(), Cost::ZERO);
