@@ -942,7 +942,7 @@ impl<'c> HybridGraph<'c> {
             p.steps = tables.step_bound.lower_bound(self.maps, feet);
             (p.behind, p.ahead) = tables.step_bound.offset_potential(o);
             (p.greedy_behind, p.greedy_ahead) = offsets_weighed(o, self.greedy_offset_per_cell);
-            p.way = tables.way.mean_of(feet).map_or(Cost::ZERO, |w| {
+            p.way = tables.way.mean_of(self.maps.heights(), feet).map_or(Cost::ZERO, |w| {
                 heuristic_cost(w).saturating_add(self.driving.turn_heuristic(s))
             });
         }

@@ -43,9 +43,7 @@ pub struct WayField {
     /// leads to the goal.
     way: Vec<u32>,
     nx: usize,
-    ny: usize,
     resolution: f64,
-    origin: [f64; 2],
 }
 
 impl WayField {
@@ -91,26 +89,22 @@ impl WayField {
                 }
             }
         }
-        Self { way, nx, ny, resolution: map.resolution(), origin: map.origin() }
+        Self { way, nx, resolution: map.resolution() }
     }
 
-    /// The way from the cell holding world point `(x, y)`, m; `None` off the map or
-    /// where no way leads to the goal.
-    pub fn at(&self, x: f64, y: f64) -> Option<f64> {
-        let i = ((x - self.origin[0]) / self.resolution).floor();
-        let j = ((y - self.origin[1]) / self.resolution).floor();
-        if !(i >= 0.0 && j >= 0.0 && i < self.nx as f64 && j < self.ny as f64) {
-            return None;
-        }
-        let w = self.way[j as usize * self.nx + i as usize];
+    /// The way from cell `(i, j)` of the map the field was built on, m; `None` where no
+    /// way leads to the goal (or off the map).
+    pub fn at_cell(&self, (i, j): (usize, usize)) -> Option<f64> {
+        let w = *self.way.get(j * self.nx + i).filter(|_| i < self.nx)?;
         (w != NONE).then(|| f64::from(w) / f64::from(AXIS) * self.resolution)
     }
 
-    /// The mean way of four feet, m; `None` if any has none.
-    pub fn mean_of(&self, feet: &[[f64; 2]; 4]) -> Option<f64> {
+    /// The mean way of four feet (world points on `map`, the map the field was built
+    /// on), m; `None` if any has none.
+    pub fn mean_of(&self, map: &HeightMap, feet: &[[f64; 2]; 4]) -> Option<f64> {
         let mut sum = 0.0;
         for &[x, y] in feet {
-            sum += self.at(x, y)?;
+            sum += self.at_cell(map.cell_of(x, y)?)?;
         }
         Some(0.25 * sum)
     }
@@ -137,12 +131,12 @@ mod tests {
     fn open_floor_gives_the_octile_distance() {
         let f = WayField::build(&map(&[]), &[[0.05, 0.05]], 0.3);
         // Cell (0, 0) is the source; (3, 0) three cells along x; (2, 2) two diagonals.
-        assert_eq!(f.at(0.05, 0.05), Some(0.0));
-        assert!((f.at(0.35, 0.05).expect("way") - 0.3).abs() < 1e-12);
-        assert!((f.at(0.25, 0.25).expect("way") - 2.0 * 0.1414).abs() < 1e-12);
-        // (5, 1): four diagonals are not needed; one diagonal and four along x.
-        assert!((f.at(0.55, 0.15).expect("way") - (0.1414 + 0.4)).abs() < 1e-12);
-        assert_eq!(f.at(-0.05, 0.05), None);
+        assert_eq!(f.at_cell((0, 0)), Some(0.0));
+        assert!((f.at_cell((3, 0)).expect("way") - 0.3).abs() < 1e-12);
+        assert!((f.at_cell((2, 2)).expect("way") - 2.0 * 0.1414).abs() < 1e-12);
+        // (5, 1): one diagonal and four along x.
+        assert!((f.at_cell((5, 1)).expect("way") - (0.1414 + 0.4)).abs() < 1e-12);
+        assert_eq!((f.at_cell((10, 0)), f.at_cell((0, 6))), (None, None));
     }
 
     #[test]
@@ -151,14 +145,15 @@ mod tests {
         let tall: Vec<_> = (0..5).map(|j| (4, j, 0.5)).collect();
         let f = WayField::build(&map(&tall), &[[0.85, 0.05]], 0.3);
         // From (0, 0): around the wall's open end, not through it.
-        let around = f.at(0.05, 0.05).expect("way");
-        assert!(around > 0.8 + 1e-9, "{around}");
-        // The wall's own cells are climbable only from each other: reached from (4, 5)?
-        // (4, 4) is 0.5 above (4, 5), so no way leads onto the wall.
-        assert_eq!(f.at(0.45, 0.05), None);
+        // From (0, 0) through the gap at (4, 5): four diagonals and one cell along y to
+        // it, as many from it to (8, 0).
+        let around = f.at_cell((0, 0)).expect("way");
+        assert!((around - (8.0 * 0.1414 + 0.2)).abs() < 1e-12, "{around}");
+        // The wall's top is 0.5 above every neighbour on the floor: no way leads onto it.
+        assert_eq!(f.at_cell((4, 0)), None);
         let low: Vec<_> = (0..5).map(|j| (4, j, 0.2)).collect();
         let f = WayField::build(&map(&low), &[[0.85, 0.05]], 0.3);
-        assert!((f.at(0.05, 0.05).expect("way") - 0.8).abs() < 1e-12);
+        assert!((f.at_cell((0, 0)).expect("way") - 0.8).abs() < 1e-12);
     }
 
     #[test]
@@ -168,15 +163,17 @@ mod tests {
             m.set(5, j, f64::NAN).expect("cell");
         }
         let f = WayField::build(&m, &[[0.85, 0.05]], 0.3);
-        assert_eq!(f.at(0.05, 0.05), None);
-        assert!(f.at(0.95, 0.55).is_some());
+        assert_eq!(f.at_cell((0, 0)), None);
+        assert!(f.at_cell((9, 5)).is_some());
         let feet = [[0.85, 0.05], [0.95, 0.05], [0.85, 0.15], [0.05, 0.05]];
-        assert_eq!(f.mean_of(&feet), None);
+        assert_eq!(f.mean_of(&m, &feet), None);
+        let off_map = [[0.85, 0.05], [0.95, 0.05], [0.85, 0.15], [1.05, 0.05]];
+        assert_eq!(f.mean_of(&m, &off_map), None);
         let feet = [[0.85, 0.05], [0.95, 0.05], [0.85, 0.15], [0.95, 0.15]];
-        let mean = f.mean_of(&feet).expect("way");
+        let mean = f.mean_of(&m, &feet).expect("way");
         assert!((mean - (0.0 + 0.1 + 0.1 + 0.1414) / 4.0).abs() < 1e-12);
         // A goal off the map is no source.
         let f = WayField::build(&m, &[[5.0, 5.0]], 0.3);
-        assert_eq!(f.at(0.85, 0.05), None);
+        assert_eq!(f.at_cell((8, 0)), None);
     }
 }
