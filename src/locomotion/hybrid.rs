@@ -476,7 +476,7 @@ struct HeuristicTables {
     /// The feet's way to the goal over terrain they could climb (`way`): the greedy
     /// list's distance where it exceeds the straight line.
     way: WayField,
-    /// Time spent building the step bound and the regions.
+    /// Time spent building the step bound, the regions and the way.
     setup: Duration,
 }
 
@@ -646,8 +646,9 @@ impl HeuristicParts {
     /// misleads where the goal lies beyond a climb: beside a flight's top the floor is
     /// nearer the goal than the flight's foot, and a probe stuck at the foot searched that
     /// floor at every heading first. The feet's way (`way` module) goes back to the foot
-    /// and up the flight. Not admissible (a foot carried over a ledge by a step goes
-    /// less far than its way), and not meant to be: ε′ comes from [`Self::total`].
+    /// and up the flight. Not a bound, nor meant to be one (the way is counted per cell,
+    /// and not every manoeuvre that shortens it pays one per metre): ε′ comes from
+    /// [`Self::total`].
     pub fn greedy_guidance(&self) -> Cost {
         let without = Self {
             to_go: Cost::ZERO,

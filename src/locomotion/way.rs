@@ -16,12 +16,12 @@
 //! largest step height (criterion 3 of a step): the feet climb nothing higher, so each
 //! foot passes along such a way. A state's way is the mean over its four feet, in
 //! metres, weighed like the straight line (one per metre); the greedy list takes the
-//! larger of the two. It is neither admissible nor meant to be (a step carries a foot over
-//! a ledge in one move, and no further than its way), so it orders only that list; the
-//! heuristic, and with it ε′, is untouched, and probes that find a path before the greedy
-//! list joins are as before. In the weighted guided list as well it found that flight's
-//! path in 22 k expansions, but it changed the paths of probes that needed no help (the
-//! paper's staircase among them).
+//! larger of the two. It is not a bound, nor meant to be one (the way is counted per cell,
+//! and not every manoeuvre that shortens it pays one per metre), so it orders only that
+//! list; the heuristic, and with it ε′, is untouched, and probes that find a path before
+//! the greedy list joins are as before. In the weighted guided list as well it found
+//! that flight's path in 22 k expansions, but it changed the paths of probes that needed
+//! no help (the paper's staircase among them).
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
