@@ -94,7 +94,8 @@ pub struct PlanOptions {
     /// expansion ordered by the heuristic without its base-pose cost-to-go,
     /// `HeuristicParts::guidance`, and after `SearchParams::probe_greedy_after`
     /// expansions without a path every third by a guidance alone, the same with the feet's
-    /// offsets weighed as the straight line weighs the base's way,
+    /// offsets weighed as the straight line weighs the base's way and that way the longer
+    /// of the straight line and the feet's way over climbable terrain,
     /// `HeuristicParts::greedy_guidance`). Default true.
     pub probe_guidance: bool,
     /// Expansions ARA*'s schedule may spend after its probe found a path
