@@ -843,8 +843,16 @@ impl<'c> HybridGraph<'c> {
         let max_step_cells = self.reach.iter().map(|r| i32::from(r[1]) - i32::from(r[0])).max();
         let max_step_length_m = f64::from(max_step_cells.unwrap_or(0).max(0)) * res;
         let (config, goal) = (&self.config, self.driving.goal());
-        let step_bound =
-            build_step_bound(self.maps, &self.near, config, &self.lattice, goal, max_step_length_m);
+        // The goal's feet: the step bound's sources and the way's.
+        let goal_feet = goal_feet(self.maps, &self.lattice, goal);
+        let step_bound = build_step_bound(
+            self.maps,
+            &self.near,
+            config,
+            &self.lattice,
+            &goal_feet,
+            max_step_length_m,
+        );
         // A base shift costs at least f · k10 per metre (C_B ≥ 1) and raises the
         // foot-offset potential by 4 c per cell (`heuristic::offset_potential`).
         let shift_step =
@@ -864,7 +872,6 @@ impl<'c> HybridGraph<'c> {
             (config.motion.base_circle_radius_m, &self.stance_limits(), &step_bound),
             (goal.i, goal.j),
         );
-        let goal_feet = goal_feet(self.maps, &self.lattice, goal);
         let goal_points: Vec<[f64; 2]> = goal_feet.iter().flatten().copied().collect();
         let max_rise = config.max_step_height_m + STEP_HEIGHT_TOLERANCE_M;
         let way = WayField::build(self.maps.heights(), &goal_points, max_rise);
@@ -2198,15 +2205,15 @@ impl<'c> HybridGraph<'c> {
     }
 }
 
-/// The step bound of the heuristic for `goal` (every orientation when the goal leaves it
-/// free). The link radius covers the largest jump of a foot's cell in a drive (2), a
+/// The step bound of the heuristic for the goal's feet `goal_feet` ([`goal_feet`]). The
+/// link radius covers the largest jump of a foot's cell in a drive (2), a
 /// turn (the chord of the widest foot) and a base shift (1), plus one against rounding.
 fn build_step_bound(
     maps: &CostMaps,
     near: &[bool],
     config: &HybridConfig,
     lattice: &Lattice,
-    goal: DrivingGoal,
+    goal_feet: &[[[f64; 2]; 4]],
     max_step_length_m: f64,
 ) -> StepBound {
     let res = lattice.resolution;
@@ -2225,10 +2232,11 @@ fn build_step_bound(
         k10: config.k10,
         k11: config.k11,
     };
-    StepBound::build(maps, near, &params, &goal_feet(maps, lattice, goal))
+    StepBound::build(maps, near, &params, goal_feet)
 }
 
-/// The neutral feet of the goal pose, one array of four per goal orientation accepted.
+/// The neutral feet of the goal pose, one array of four per goal orientation accepted
+/// (every orientation when the goal leaves it free).
 fn goal_feet(maps: &CostMaps, lattice: &Lattice, goal: DrivingGoal) -> Vec<[[f64; 2]; 4]> {
     let thetas: Vec<u8> = match goal.theta {
         Some(t) => vec![t],

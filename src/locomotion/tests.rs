@@ -1366,8 +1366,7 @@ mod hybrid {
 }
 
 #[test]
-fn the_probes_guidance_is_the_heuristic_without_its_cost_to_go_and_its_greedy_one_counts_the_feet_way()
- {
+fn the_probes_guidance_drops_the_cost_to_go_and_its_greedy_one_counts_the_feet_way() {
     // h = max(2, 15) + 30 + 1 − 0.5 = 45.5; guidance = 2 + 30 + 1 − 0.5 = 32.5; the
     // greedy list's = 2 + 30 + 0.25 − 0.125 = 32.125 (the offsets at its own weight).
     let u = |v: f64| Cost::from_f64(v);

@@ -16,17 +16,19 @@
 //! largest step height (criterion 3 of a step; a diagonal move's two side cells too): the
 //! feet climb nothing higher, so each foot passes along such a way. A state's way is the
 //! mean over its four feet, in metres, weighed like the straight line (one per metre),
-//! plus the driving part's turn; the greedy list takes the larger of the two. The octile
-//! way exceeds the straight line by up to 8 % on open ground; divided by that excess, so
-//! that it takes over only where it goes around or up to something, it no longer helped
-//! `stairs_000009` (388 k expansions): the floor beside the flight's first treads, from
-//! which the field lets feet climb the first tread sideways, is then level with the
-//! flight's foot. What the way settles is the floor farther along the flight. It is not a bound, nor meant to be one (the way is counted per cell,
-//! and not every manoeuvre that shortens it pays one per metre), so it orders only that
-//! list; the heuristic, and with it ε′, is untouched, and probes that find a path before
-//! the greedy list joins are as before. In the weighted guided list as well it found
-//! that flight's path in 22 k expansions, but it changed the paths of probes that needed
-//! no help (the paper's staircase among them).
+//! plus the driving part's turn; the greedy list takes the larger of the two.
+//!
+//! It is not a bound, nor meant to be one (the way is counted per cell, and not every
+//! manoeuvre that shortens it pays one per metre), so it orders only that list; the
+//! heuristic, and with it ε′, is untouched, and probes that find a path before the greedy
+//! list joins are as before. In the weighted guided list as well it found that flight's
+//! path in 22 k expansions, but it changed the paths of probes that needed no help (the
+//! paper's staircase among them). The octile way exceeds the straight line by up to 8 %
+//! on open ground; divided by that excess, so that it would take over only where it goes
+//! around or up to something, it no longer helped `stairs_000009` (388 k expansions): the
+//! floor beside the flight's first treads, from which the field lets feet climb the first
+//! tread sideways, is then level with the flight's foot. What the way settles is the floor
+//! farther along the flight; the field knows nothing of headings.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
