@@ -404,29 +404,19 @@ impl HeightMap {
     /// around (i, j) here (NaN where none is known): what a body part of up to r cells'
     /// reach over a cell must clear, answered by one look-up.
     pub fn dilated_max(&self, r: usize) -> HeightMap {
-        // Separable: the max over the row window, then over the column window of those
-        // (O(r) per cell, not O(r²)). `f64::max` passes over NaN, so unknown cells drop
-        // out; a window with none known stays −∞ and becomes NaN.
-        let (nx, ny) = (self.nx, self.ny);
-        let mut rows = vec![f64::NEG_INFINITY; nx * ny];
-        for j in 0..ny {
-            for i in 0..nx {
-                let (a, b) = (i.saturating_sub(r), (i + r).min(nx - 1));
-                rows[j * nx + i] = self.data[j * nx + a..=j * nx + b]
-                    .iter()
-                    .copied()
-                    .fold(f64::NEG_INFINITY, f64::max);
-            }
-        }
+        // [`square_window_max`], O(1) a cell whatever r (the reachable regions dilate by
+        // 28 cells, which took a twentieth of a cold plan's time at O(r) a cell). Unknown
+        // cells count as −∞, so they drop out; a window with none known stays −∞ and
+        // becomes NaN. The max is exact in any order: the values are the direct block
+        // maximum's.
+        let known: Vec<f64> =
+            self.data.iter().map(|&v| if v.is_nan() { f64::NEG_INFINITY } else { v }).collect();
         let mut out = self.clone();
         out.blocks = OnceLock::new();
-        for j in 0..ny {
-            let (a, b) = (j.saturating_sub(r), (j + r).min(ny - 1));
-            for i in 0..nx {
-                let m = (a..=b).map(|jj| rows[jj * nx + i]).fold(f64::NEG_INFINITY, f64::max);
-                out.data[j * nx + i] = if m.is_finite() { m } else { f64::NAN };
-            }
-        }
+        out.data = square_window_max(&known, self.nx, r)
+            .into_iter()
+            .map(|m| if m.is_finite() { m } else { f64::NAN })
+            .collect();
         out
     }
 
@@ -709,6 +699,73 @@ fn solve_linear(k: f64, lo: f64, hi: f64) -> Option<(f64, f64)> {
     }
 }
 
+/// Per cell of a row-major grid `nx` cells wide, the largest of `values` over the
+/// (2r + 1)² cells around it, clipped to the grid (−∞ where the grid holds none; NaN
+/// values are the caller's to map first: `f64::max` skips them). Separable: the max over
+/// the row window, then over the column window of those, each by van Herk and
+/// Gil-Werman's running maxima, three comparisons a cell whatever r.
+pub fn square_window_max(values: &[f64], nx: usize, r: usize) -> Vec<f64> {
+    let ny = values.len().checked_div(nx).unwrap_or(0);
+    let mut scratch = WindowMax::default();
+    let mut rows = vec![f64::NEG_INFINITY; nx * ny];
+    for j in 0..ny {
+        let row = j * nx..(j + 1) * nx;
+        scratch.run(values[row.clone()].iter().copied(), r, &mut rows[row]);
+    }
+    let mut out = vec![f64::NEG_INFINITY; nx * ny];
+    let mut column = vec![f64::NEG_INFINITY; ny];
+    for i in 0..nx {
+        scratch.run((0..ny).map(|j| rows[j * nx + i]), r, &mut column);
+        for (j, &m) in column.iter().enumerate() {
+            out[j * nx + i] = m;
+        }
+    }
+    out
+}
+
+/// Van Herk and Gil-Werman's sliding-window maximum, its buffers kept between runs.
+#[derive(Debug, Default)]
+struct WindowMax {
+    /// The values, padded with r times −∞ at either end.
+    padded: Vec<f64>,
+    /// Running maxima from each block's start, and to each block's end (blocks of
+    /// 2r + 1 padded values).
+    from_start: Vec<f64>,
+    to_end: Vec<f64>,
+}
+
+impl WindowMax {
+    /// `out[i]` = the max of `values[i − r ..= i + r]` (clamped to the values; −∞ where
+    /// none): a window spans the end of one block and the start of the next, or exactly
+    /// one block, so it is the larger of two running maxima.
+    fn run(&mut self, values: impl Iterator<Item = f64>, r: usize, out: &mut [f64]) {
+        let w = 2 * r + 1;
+        self.padded.clear();
+        self.padded.resize(r, f64::NEG_INFINITY);
+        self.padded.extend(values);
+        let n = self.padded.len() - r;
+        self.padded.resize(n + 2 * r, f64::NEG_INFINITY);
+        let m = self.padded.len();
+        self.from_start.clear();
+        self.from_start.extend_from_slice(&self.padded);
+        for k in 1..m {
+            if k % w != 0 {
+                self.from_start[k] = self.from_start[k].max(self.from_start[k - 1]);
+            }
+        }
+        self.to_end.clear();
+        self.to_end.extend_from_slice(&self.padded);
+        for k in (0..m.saturating_sub(1)).rev() {
+            if k % w != w - 1 {
+                self.to_end[k] = self.to_end[k].max(self.to_end[k + 1]);
+            }
+        }
+        for (i, o) in out.iter_mut().enumerate().take(n) {
+            *o = self.to_end[i].max(self.from_start[i + 2 * r]);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
 
@@ -769,7 +826,8 @@ mod tests {
         for (i, j) in [(4, 4), (5, 4), (0, 0), (1, 0), (0, 1), (1, 1), (12, 8)] {
             hm.set(i, j, f64::NAN).unwrap();
         }
-        for r in 0..4 {
+        // Windows within, across and wider than the map (van Herk's blocks and padding).
+        for r in [0, 1, 2, 3, 4, 5, 8, 12, 20] {
             let d = hm.dilated_max(r);
             for j in 0..9 {
                 for i in 0..13 {

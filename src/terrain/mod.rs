@@ -9,6 +9,6 @@ pub mod heightmap;
 pub mod rasterise;
 pub mod sensed;
 
-pub use heightmap::{HeightMap, HeightMapError, HeightMapView};
+pub use heightmap::{HeightMap, HeightMapError, HeightMapView, square_window_max};
 pub use rasterise::{RasteriseError, rasterise, rasterise_into};
 pub use sensed::{LaserScanner, RayCaster, RayHit, ScanStats, SensedError};
