@@ -449,18 +449,20 @@ fn admissible_scan(
         .map(|&(di, dj)| di.unsigned_abs().max(dj.unsigned_abs()))
         .max()
         .unwrap_or(0);
-    let too_high = |v: Option<f64>| v.unwrap_or(f64::INFINITY);
     let grid = |f: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
         (0..nx * ny).map(|k| f(k % nx, k / nx)).collect()
     };
-    let body_top = square_window_max(&grid(&|i, j| too_high(body.get(i, j))), nx, span);
-    let legs_top = square_window_max(&grid(&|i, j| too_high(legs.get(i, j))), nx, span);
     // The look-ups as plain values: a body probe passes where its value is within the
     // bound, an unknown one never (+∞), a leg probe likewise, an unknown one always
     // (−∞: `legs_clear` lets it pass too); off the map the same. A cell `span` inside the
     // map reads its probes at fixed offsets in the row-major grid, with no test.
     let body_at = grid(&|i, j| body.get(i, j).unwrap_or(f64::INFINITY));
     let legs_at = grid(&|i, j| legs.get(i, j).unwrap_or(f64::NEG_INFINITY));
+    let body_top = square_window_max(&body_at, nx, span);
+    // Here an unknown leg cell counts as too high instead: the quick pass then leaves
+    // its cell to the probes.
+    let legs_top =
+        square_window_max(&grid(&|i, j| legs.get(i, j).unwrap_or(f64::INFINITY)), nx, span);
     let linear = |(di, dj): (isize, isize)| di + dj * nx as isize;
     let offsets: Vec<([isize; 2], [[isize; HIP_BAND_X.len() * HIP_BAND_Y.len()]; 4])> = probes
         .iter()

@@ -411,13 +411,11 @@ impl HeightMap {
         // maximum's.
         let known: Vec<f64> =
             self.data.iter().map(|&v| if v.is_nan() { f64::NEG_INFINITY } else { v }).collect();
-        let mut out = self.clone();
-        out.blocks = OnceLock::new();
-        out.data = square_window_max(&known, self.nx, r)
+        let data = square_window_max(&known, self.nx, r)
             .into_iter()
             .map(|m| if m.is_finite() { m } else { f64::NAN })
             .collect();
-        out
+        HeightMap { data, blocks: OnceLock::new(), ..*self }
     }
 
     /// Highest known height over the (2r + 1)² cells around the cell containing (x, y),
