@@ -561,6 +561,47 @@ mod hybrid {
     }
 
     #[test]
+    fn the_roll_finds_the_front_foot_move_that_trying_the_longest_first_finds() {
+        // The longest feasible front-foot-forward move is found by rolling the foot cell
+        // by cell up to the first cell or segment that fails; trying every move longest
+        // first (as before) must pick the same. Poses before, on and across a platform's
+        // edge, at several headings, with feet behind and ahead of neutral, so that the
+        // longest move, a shorter one and none at all are each chosen.
+        let maps = platform_maps(0.2);
+        let goal = LatticeState::new(0, 0, 0);
+        let (mut rolled, mut tried) = (graph(&maps, goal), graph(&maps, goal));
+        let footprints: [FootOffsets; 5] =
+            [[0, 0, 0, 0], [0, 0, -8, -8], [6, 0, -4, 0], [0, 10, 0, -12], [12, 12, -16, -16]];
+        let (mut longest, mut shorter, mut none) = (0, 0, 0);
+        for x in [0.2, 0.45, 0.6, 0.8, 1.05, 1.3] {
+            for y in [-0.2, 0.0, 0.25] {
+                for yaw in [0.0, 0.3, -0.6, 1.2] {
+                    let at = state_on(&maps, x, y, yaw);
+                    for o in footprints {
+                        let (Some(a), Some(b)) =
+                            (rolled.with_offsets(at, o), tried.with_offsets(at, o))
+                        else {
+                            continue;
+                        };
+                        for k in [0, 1] {
+                            let (by_roll, end) = rolled.forward_move(a, k, false);
+                            let (by_trying, _) = tried.forward_move(b, k, true);
+                            assert_eq!(by_roll, by_trying, "({x}, {y}, {yaw}) {o:?} leg {k}");
+                            match (by_roll, end) {
+                                (None, Some(_)) => none += 1,
+                                (Some(to), Some(end)) if to[k] == end => longest += 1,
+                                (Some(_), _) => shorter += 1,
+                                (None, None) => {}
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(longest > 0 && shorter > 0 && none > 0, "{longest} {shorter} {none}");
+    }
+
+    #[test]
     fn base_shift_after_both_front_steps_costs_c_bs() {
         let maps = platform_maps(0.2);
         let mut g = graph(&maps, LatticeState::new(0, 0, 0));
