@@ -201,3 +201,31 @@ fn planner_com_estimate_equals_mujocos_in_the_horizontal() {
     }
     assert_eq!(checked, 4);
 }
+
+#[test]
+fn terrain_solids_in_bodies_of_their_own_are_drawn_and_found_as_before() {
+    // Every solid of a world is a static body of its own (MuJoCo's broadphase passes over
+    // the far ones; `sim::world`). The robot's bodies are still the recordings' bodies,
+    // the same as with no terrain at all, and every block's geom is reported as the
+    // world's, where the scenario puts it.
+    let sc = common::scenario("staircase");
+    let sim = Simulation::new(&sc, &common::model()).expect("world compiles");
+    let alone = Simulation::robot_only(&common::model()).expect("model compiles");
+    let names = |s: &Simulation| s.body_poses().into_iter().map(|b| b.name).collect::<Vec<_>>();
+    assert_eq!(names(&sim), names(&alone));
+    assert!(names(&sim).iter().all(|n| !n.starts_with("terrain_")), "{:?}", names(&sim));
+    let shapes = sim.geom_shapes();
+    let mut blocks = 0;
+    for (i, prim) in sc.terrain.iter().enumerate() {
+        for (k, b) in prim.blocks().iter().enumerate() {
+            let name = format!("terrain_{i}_{k}");
+            let g = shapes.iter().find(|g| g.name == name).expect("a geom per block");
+            assert_eq!(g.body, 0, "{name}");
+            let expected = [b.center[0], b.center[1], b.height / 2.0];
+            let off = (0..3).map(|c| (g.local_position[c] - expected[c]).abs()).fold(0.0, f64::max);
+            assert!(off < 1e-9, "{name}: {g:?}");
+            blocks += 1;
+        }
+    }
+    assert!(blocks > 5, "{blocks} blocks");
+}

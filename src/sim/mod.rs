@@ -527,10 +527,19 @@ impl Simulation {
         self.data.xfrc_applied_mut()[b] = [force[0], force[1], force[2], 0.0, 0.0, 0.0];
     }
 
-    /// World pose of every robot body, in model order.
+    /// Whether body `b` is part of the robot (its root, the world's child it hangs from,
+    /// is the base's), not a terrain solid's static body (`world`).
+    fn is_robot_body(&self, b: usize) -> bool {
+        let root = self.model.body_rootid();
+        b > 0 && root.get(b) == root.get(self.base_body)
+    }
+
+    /// World pose of every robot body, in model order: bodies 1 to N, the robot's file
+    /// being included before the terrain (`world`).
     pub fn body_poses(&self) -> Vec<BodyPose> {
         let (xpos, xquat) = (self.data.xpos(), self.data.xquat());
         (1..self.model.ffi().nbody as usize)
+            .filter(|&b| self.is_robot_body(b))
             .map(|b| BodyPose {
                 name: self.model.id_to_name(MjtObjBase::mjOBJ_BODY, b).unwrap_or("").to_owned(),
                 position: xpos[b],
@@ -539,7 +548,9 @@ impl Simulation {
             .collect()
     }
 
-    /// Shapes of all geoms (terrain and robot), each in its body's frame.
+    /// Shapes of all geoms (terrain and robot), each in its body's frame; a terrain
+    /// solid's geom as the world's (body 0: its static body sits at the world's origin
+    /// unrotated, see `world`).
     pub fn geom_shapes(&self) -> Vec<GeomShape> {
         let m = &self.model;
         (0..m.ffi().ngeom as usize)
@@ -555,7 +566,10 @@ impl Simulation {
                 };
                 Some(GeomShape {
                     name: m.id_to_name(MjtObjBase::mjOBJ_GEOM, g).unwrap_or("").to_owned(),
-                    body: usize::try_from(m.geom_bodyid()[g]).unwrap_or(0),
+                    body: usize::try_from(m.geom_bodyid()[g])
+                        .ok()
+                        .filter(|&b| self.is_robot_body(b))
+                        .unwrap_or(0),
                     kind,
                     size: m.geom_size()[g],
                     rgba: m.geom_rgba()[g],
