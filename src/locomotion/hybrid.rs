@@ -1375,34 +1375,8 @@ impl<'c> HybridGraph<'c> {
     /// checking the cells alone let a knee pass within it over a block's edge between two.
     fn wheel_move_feasible(&mut self, s: LatticeState, o: &FootOffsets, m: &FootMove) -> bool {
         // The end first: where it cannot stand, the way needs no look.
-        if !self.target_ok(s, &m.to) {
-            return false;
-        }
-        let k = m.leg.index();
-        let (from, to) = (i32::from(o[k]), i32::from(m.to[k]));
-        let mut via = *o;
-        // The offsets strictly between the two ends.
-        let cells_ok = (from.min(to) + 1..from.max(to)).all(|v| {
-            via[k] = v as i8;
-            self.target_ok(s, &via)
-        });
-        if !cells_ok {
-            return false;
-        }
-        let dir = (to - from).signum();
-        let mut a = *o;
-        let mut a_clear = self.stand(s, &a) == Stand::SweptClear;
-        while i32::from(a[k]) != to {
-            let mut b = a;
-            b[k] = (i32::from(a[k]) + dir) as i8;
-            let b_clear = self.stand(s, &b) == Stand::SweptClear;
-            let swept = a_clear && b_clear;
-            if !swept && !self.wheel_segment_ok(s, &a, m.leg, &b) {
-                return false;
-            }
-            (a, a_clear) = (b, b_clear);
-        }
-        true
+        let to = m.to[m.leg.index()];
+        self.target_ok(s, &m.to) && self.feasible_roll(s, o, m.leg, to, to) == to
     }
 
     /// The generator's one-cell wheel move of `leg`'s pair from footprint `a` to `b` at
@@ -1935,12 +1909,13 @@ impl<'c> HybridGraph<'c> {
 
     /// How far `leg`'s wheel pair rolls from footprint `o` at `s` toward offset `to`:
     /// the last offset of the longest way from `o` whose every cell can stand
-    /// ([`Self::target_ok`]) and every one-cell segment passes (the checks of
-    /// [`Self::wheel_move_feasible`]). A move is feasible exactly when its end lies on
-    /// that way: both conditions hold for a way when they hold for a longer one, so the
-    /// cells are looked at nearest first, each once, up to the first that fails, and the
-    /// segments only up to there, and only where that reaches `at_least` (the offset of
-    /// the shortest move wanted; short of it, the cells' reach is returned).
+    /// ([`Self::target_ok`]) and every one-cell segment passes (the checks
+    /// [`Self::wheel_move_feasible`] describes, and makes by this roll). A move is
+    /// feasible exactly when its end lies on that way: both conditions hold for a way when
+    /// they hold for a longer one, so the cells are looked at nearest first, each once, up
+    /// to the first that fails, and the segments only up to there, and only where that
+    /// reaches `at_least` (the offset of the shortest move wanted; short of it, the cells'
+    /// reach is returned).
     fn feasible_roll(
         &mut self,
         s: LatticeState,
