@@ -6,7 +6,7 @@
 //! Run: `cargo bench --bench search`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use momaro::planner::{Cost, SearchGraph, SearchParams, arastar, astar};
+use momaro::search::{Cost, SearchGraph, SearchParams, arastar, astar};
 use std::hint::black_box;
 
 const N: i32 = 400;

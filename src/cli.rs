@@ -514,7 +514,7 @@ fn print_plan_failure(json: bool, scenario: &std::path::Path, e: &anyhow::Error)
     let kind = e.chain().find_map(|c| {
         if let Some(jobs::plan::PlanJobError::NoPath { termination, .. }) = c.downcast_ref() {
             Some(match termination {
-                crate::planner::Termination::NoPath => "no_path",
+                crate::search::Termination::NoPath => "no_path",
                 _ => "planning_time_limit",
             })
         } else if let Some(jobs::detailed::DetailedJobError::Motion { .. }) = c.downcast_ref() {

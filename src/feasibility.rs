@@ -13,13 +13,13 @@
 //!
 //! The generator checks this at every keyframe and at points 1 cm / 0.02 rad apart between
 //! them; the planner checks it once per lattice pose (memoised with the pose cost) against
-//! terrain dilated by [`SWEEP_CELLS`] more cells, which covers every point of the legs
+//! terrain dilated by [`crate::cost::SWEEP_CELLS`] more cells, which covers every point of the legs
 //! between two neighbouring lattice poses: a move of the 20-neighbourhood (at most
 //! √5 cells, 5.6 cm) or a turn of 2π/64 (4.6 cm at the farthest leg point, 0.47 m from the
 //! centre) brings no leg point farther than 2.8 cm from where it stood at one of the two
 //! ends.
 //!
-//! Stepping uses the standing rule of `motion::standing` (its step heights are what the
+//! Stepping uses the standing rule of `posture::standing` (its step heights are what the
 //! planner's reach check and the generator's step candidates share), and the planner runs
 //! the generator's own step check (`motion::expand::ManoeuvreCheck::step`) on the steps it admits,
 //! and its own wheel-move and base-shift expansions (`ManoeuvreCheck::wheel_move`,
@@ -29,17 +29,12 @@
 
 use crate::cost::CostMaps;
 use crate::geometry::Pose2;
-use crate::motion::kinematics::{self, Posture, PostureError, solve_chains};
-use crate::motion::standing::{self, StandingRule};
 use crate::params::Params;
+use crate::posture::kinematics::{self, Posture, PostureError, solve_chains};
+use crate::posture::standing::{self, StandingRule};
 use crate::robot::RobotDescription;
-use crate::stability::stability_margin;
+use crate::support::stability_margin;
 use crate::terrain::HeightMap;
-
-/// Extra cells by which the planner's leg terrain is dilated beyond the generator's
-/// (`cost::LEG_TERRAIN_CELLS`): two cells (5 cm) ≥ the 2.8 cm a leg point moves away from
-/// both ends of a lattice edge (see the module docs).
-pub const SWEEP_CELLS: usize = 2;
 
 /// Clearance the base's underside keeps above the terrain under its circles, m.
 pub const BODY_CLEARANCE_M: f64 = 0.02;

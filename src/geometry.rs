@@ -57,6 +57,18 @@ pub fn wrap_angle(a: f64) -> f64 {
     if w > PI { w - TAU } else { w }
 }
 
+/// Distance from `p` to the segment from `a` to `b` in the plane.
+pub fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    norm2(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -174,12 +174,12 @@ fn reference_description_for_unit_tests_equals_the_model() {
 
 #[test]
 fn planner_com_estimate_equals_mujocos_in_the_horizontal() {
-    // The planner's lumped CoM (motion::standing::com_estimate) against MuJoCo's for
+    // The planner's lumped CoM (posture::standing::com_estimate) against MuJoCo's for
     // standing postures like those of a rear step up: pitched base, a rear foot stretched
     // back, front feet forward. Thigh and shin are symmetric about their midpoints and the
     // foot hangs vertically under the ankle, so the horizontal CoM is exact.
-    use momaro::motion::kinematics::{Posture, solve_legs};
-    use momaro::motion::standing::com_estimate;
+    use momaro::posture::kinematics::{Posture, solve_legs};
+    use momaro::posture::standing::com_estimate;
     let mut sim = Simulation::robot_only(&common::model()).expect("model compiles");
     let robot = sim.robot().clone();
     let mut checked = 0;

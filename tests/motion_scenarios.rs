@@ -4,7 +4,7 @@
 //! reach and joint limits.
 //!
 //! Planner and generator share the standing leg-height rule of Sec. VI-B
-//! (`motion::standing`), so every planned footprint can be stood in; the planner's support
+//! (`posture::standing`), so every planned footprint can be stood in; the planner's support
 //! check keeps steps the alignment manoeuvres can stabilise.
 
 mod common;

@@ -87,7 +87,7 @@ fn assert_stopped_by_expansion_limit(result: &Result<PlanSummary, PlanJobError>,
         matches!(
             result,
             Err(PlanJobError::NoPath {
-                termination: momaro::planner::Termination::ExpansionLimit,
+                termination: momaro::search::Termination::ExpansionLimit,
                 ..
             })
         ),

@@ -90,6 +90,11 @@ pub enum CostError {
 /// the leg capsule's 2.5 cm radius and the half cell a point may sit off its cell centre).
 pub const LEG_TERRAIN_CELLS: usize = 2;
 
+/// Extra cells by which the planner's leg terrain ([`CostMaps::swept_leg_terrain`]) is
+/// dilated beyond the generator's: two cells (5 cm) ≥ the 2.8 cm a leg point moves away
+/// from both ends of a lattice edge (see `feasibility`'s module docs).
+pub const SWEEP_CELLS: usize = 2;
+
 /// Cell offsets of a driving pose's look-ups for one yaw ([`CostMaps::driving_stencil`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DrivingStencil {
@@ -184,7 +189,7 @@ impl CostMaps {
             foot_cells,
             disc_max: DiscMaxLayer::compute(map, params.base_circle_radius_m),
             leg_terrain: map.dilated_max(LEG_TERRAIN_CELLS),
-            swept_leg_terrain: map.dilated_max(LEG_TERRAIN_CELLS + crate::feasibility::SWEEP_CELLS),
+            swept_leg_terrain: map.dilated_max(LEG_TERRAIN_CELLS + SWEEP_CELLS),
             body,
             weights: PoseWeights { k4: params.k4, k5: params.k5, k6: params.k6 },
             neutral_footprint: robot.neutral_footprint(),
@@ -225,12 +230,12 @@ impl CostMaps {
     }
 
     /// The heights dilated by [`LEG_TERRAIN_CELLS`] cells: per cell the highest terrain a
-    /// leg segment (capsule radius 2.5 cm) over it could touch (`motion::standing`).
+    /// leg segment (capsule radius 2.5 cm) over it could touch (`posture::standing`).
     pub fn leg_terrain(&self) -> &HeightMap {
         &self.leg_terrain
     }
 
-    /// The heights dilated by [`crate::feasibility::SWEEP_CELLS`] more cells than
+    /// The heights dilated by [`SWEEP_CELLS`] more cells than
     /// [`Self::leg_terrain`]: the planner checks lattice poses against it, so that the
     /// legs clear the terrain everywhere between two neighbouring poses
     /// (`feasibility`).

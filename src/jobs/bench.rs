@@ -15,9 +15,9 @@
 
 use super::plan::{self, PlanJobError, PlanOptions};
 use super::sim::{SimJobError, SimOptions};
-use crate::planner::Termination;
 use crate::robot::RobotDescription;
 use crate::scenario::Scenario;
+use crate::search::Termination;
 use crate::sim::Simulation;
 use serde::Serialize;
 use std::path::PathBuf;

@@ -6,7 +6,7 @@
 //! cells at the edge of the planning area still see their whole foot-cost neighbourhood.
 
 use crate::cost::{CostError, CostMaps};
-use crate::cost_image::{self, ImageError, RgbImage};
+use crate::render::{self, ImageError, RgbImage};
 use crate::scenario::Scenario;
 use crate::sim::{SimError, Simulation};
 use crate::terrain::sensed::{SensedAgreement, agreement};
@@ -183,16 +183,10 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
     let (nx, ny) = heights.dims();
     let foot: Vec<_> = (0..nx * ny).map(|k| maps.foot_cost_cell(k % nx, k / nx)).collect();
     let layers: Vec<(&str, Option<RgbImage>)> = vec![
-        ("height", cost_image::height_image(&heights)),
-        ("foot_cost", cost_image::cost_layer_image(&foot, nx, ny, None)),
-        (
-            "body_cost",
-            cost_image::cost_layer_image(&maps.body_cost_layer(theta, leg), nx, ny, None),
-        ),
-        (
-            "pose_cost",
-            cost_image::cost_layer_image(&maps.pose_cost_layer(theta, leg), nx, ny, None),
-        ),
+        ("height", render::height_image(&heights)),
+        ("foot_cost", render::cost_layer_image(&foot, nx, ny, None)),
+        ("body_cost", render::cost_layer_image(&maps.body_cost_layer(theta, leg), nx, ny, None)),
+        ("pose_cost", render::cost_layer_image(&maps.pose_cost_layer(theta, leg), nx, ny, None)),
     ];
     let mut images = Vec::new();
     if let Some(dir) = &opts.png_dir {
@@ -201,7 +195,7 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
         for (name, img) in &layers {
             if let Some(img) = img {
                 let path = dir.join(format!("{}_{name}.png", scenario.name));
-                cost_image::write_png(img, &path)?;
+                render::write_png(img, &path)?;
                 images.push(path);
             }
         }

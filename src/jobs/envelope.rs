@@ -21,7 +21,7 @@
 
 use super::check::{self, CheckError, CheckOptions, CheckRow, Finished};
 use super::run::FailureKind;
-use crate::cost_image::{ImageError, RgbImage, write_png};
+use crate::render::{ImageError, RgbImage, write_png};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

@@ -12,7 +12,7 @@ pub mod plan_recording;
 pub mod run;
 pub mod sim;
 
-use crate::control::stand::neutral_posture;
+use crate::posture::neutral_posture;
 use crate::robot::ik::IkError;
 use crate::scenario::Scenario;
 use crate::sim::Simulation;

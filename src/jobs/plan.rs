@@ -12,7 +12,7 @@
 //! against it, and the search gets what is left, so a call never takes much longer than
 //! the limit. With
 //! [`PlanOptions::expansion_image`] the expansions per base cell are counted and drawn
-//! (`cost_image::expansion_image`), whether a path was found or not.
+//! (`render::expansion_image`), whether a path was found or not.
 //!
 //! Path costs are reported twice: `search_cost` as searched (with the orientation factor
 //! k_Δθ of the chosen k12) and `cost`, "the costs the path would have in the plain A*
@@ -31,12 +31,12 @@ use crate::locomotion::{
     LatticeState, ManoeuvreKind, ManoeuvreStats, Neighbourhood, PoseKey, StepCost,
 };
 use crate::params::{FootModel, InvalidParam, Params, StepModel};
-use crate::planner::{
+use crate::robot::{Leg, RobotDescription};
+use crate::scenario::{PAPER_MODEL_FLIGHT_STEPS, Scenario, longest_flight};
+use crate::search::{
     Cost, ExpandHook, Expansion, Hooks, SearchError, SearchParams, SearchResult, Termination,
     arastar_with_hooks, astar_with_hooks,
 };
-use crate::robot::{Leg, RobotDescription};
-use crate::scenario::{PAPER_MODEL_FLIGHT_STEPS, Scenario, longest_flight};
 use crate::terrain::{RasteriseError, rasterise};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -115,7 +115,7 @@ pub struct PlanOptions {
     /// Edges to leave out: manoeuvres the motion generator could not expand in an
     /// earlier plan of the same run (`jobs::run::plan_mission`).
     pub forbidden: Vec<(PoseKey, PoseKey)>,
-    /// Write a PNG of where the search went (`cost_image::expansion_image`: expansions
+    /// Write a PNG of where the search went (`render::expansion_image`: expansions
     /// per base cell over the height map), whatever the outcome: a search that finds no
     /// path shows where it spent its expansions. Default none.
     pub expansion_image: Option<PathBuf>,
@@ -147,7 +147,7 @@ pub enum PlanJobError {
     #[error(transparent)]
     Image {
         /// The cause (names the file).
-        source: crate::cost_image::ImageError,
+        source: crate::render::ImageError,
     },
     /// An option is out of range.
     #[error("invalid option `{option}`: {reason}")]
@@ -853,7 +853,7 @@ fn search_prepared(
         search(&mut graph, prep.start, opts.algorithm, &search_params, None, counts.as_deref_mut())
             .map_err(|source| PlanJobError::Search { scenario: file(), source })?;
     if let (Some(path), Some(c)) = (&opts.expansion_image, &counts) {
-        crate::cost_image::write_expansion_png(prep.maps.heights(), c, path)
+        crate::render::write_expansion_png(prep.maps.heights(), c, path)
             .map_err(|source| PlanJobError::Image { source })?;
     }
     let Some(best) = result.best() else {

@@ -5,7 +5,7 @@
 use super::costmap::{CostmapError, rasterised_map};
 use super::plan::{PathKind, PlanSummary};
 use crate::cost::CostMaps;
-use crate::cost_image;
+use crate::render;
 use crate::robot::RobotDescription;
 use crate::scenario::Scenario;
 use crate::viz::{Recorder, VizError};
@@ -41,7 +41,7 @@ pub fn record(
     rec.log_height_map(&heights)?;
     let (nx, ny) = heights.dims();
     let foot: Vec<_> = (0..nx * ny).map(|k| maps.foot_cost_cell(k % nx, k / nx)).collect();
-    if let Some(img) = cost_image::cost_layer_image(&foot, nx, ny, None) {
+    if let Some(img) = render::cost_layer_image(&foot, nx, ny, None) {
         rec.log_layer_image("foot_cost", &img, heights.origin(), heights.resolution())?;
     }
     let poses: Vec<_> = summary.path.iter().map(|e| e.pose).collect();

@@ -568,7 +568,7 @@ fn unexecuted(
 ) -> Result<RunSummary, RunJobError> {
     let kind = match &e {
         RunJobError::Plan(PlanJobError::NoPath { termination, .. }) => match termination {
-            crate::planner::Termination::NoPath => FailureKind::NoPath,
+            crate::search::Termination::NoPath => FailureKind::NoPath,
             _ => FailureKind::PlanningTimeLimit,
         },
         RunJobError::Motion { .. } => FailureKind::MotionGeneration,
@@ -690,7 +690,7 @@ pub fn execute(
             let (maps, planned) = (&prep.maps, prep.maps.heights());
             let (nx, ny) = planned.dims();
             let foot: Vec<_> = (0..nx * ny).map(|k| maps.foot_cost_cell(k % nx, k / nx)).collect();
-            if let Some(img) = crate::cost_image::cost_layer_image(&foot, nx, ny, None) {
+            if let Some(img) = crate::render::cost_layer_image(&foot, nx, ny, None) {
                 r.log_layer_image("foot_cost", &img, planned.origin(), planned.resolution())?;
             }
             log_mission(&r, &mission)?;

@@ -80,7 +80,7 @@
 use super::driving::DrivingConfig;
 use super::lattice::{Lattice, LatticeState};
 use crate::cost::{CostMaps, DrivingStencil};
-use crate::planner::Cost;
+use crate::search::Cost;
 use std::cell::{Cell, RefCell};
 use std::time::Instant;
 

@@ -38,7 +38,7 @@ use super::lattice::{Lattice, LatticeState, Move, NEUTRAL_FOOTPRINT, Neighbourho
 use super::orientation::OrientationFactor;
 use crate::geometry::Pose2;
 use crate::params::Params;
-use crate::planner::{
+use crate::search::{
     Cost, Hooks, SearchError, SearchGraph, SearchParams, SearchResult, arastar_with_hooks,
     astar_with_hooks,
 };

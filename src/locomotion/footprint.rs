@@ -17,7 +17,7 @@
 //! [`LatticeState::footprint`]: super::LatticeState::footprint
 
 use super::lattice::NEUTRAL_FOOTPRINT;
-use crate::planner::FxBuild;
+use crate::search::FxBuild;
 use std::collections::HashMap;
 
 /// Per-leg longitudinal foot offsets from the neutral footprint, in grid cells along the

@@ -95,7 +95,7 @@
 //! the least).
 
 use crate::cost::{Cost as CostValue, CostMaps};
-use crate::planner::Cost;
+use crate::search::Cost;
 
 /// Tolerance of the step height criterion (criterion 3), m: heights built from sums of
 /// floats sit a few ulps off their nominal value (three 0.1 m rises make a plateau

@@ -38,7 +38,7 @@
 //! **Choices where the paper is silent** (each tested in `locomotion::tests`):
 //! - *Leg reach.* A non-neutral footprint is allowed only if the robot can stand in it by
 //!   the leg-height rule of Sec. VI-B that the step motion generator uses
-//!   ([`crate::motion::standing::StandingRule`]): base pitched by 70 % of the slope, its
+//!   ([`crate::posture::standing::StandingRule`]): base pitched by 70 % of the slope, its
 //!   height set by the highest foot, the leg height lowered from 0.45 m in 1 cm steps until
 //!   every leg reaches its foot (sagittal IK within the joint limits). A step must in
 //!   addition stay within reach while the foot is carried: the stepping leg counting the
@@ -50,7 +50,7 @@
 //!   generator. A plan whose step no alignment can stabilise is useless to it, so a step
 //!   must pass the generator's own check (`motion::expand::ManoeuvreCheck::step`: roll,
 //!   wheel to centre, base shift, lift, swing, place and back, every centimetre, with the
-//!   CoM estimate `motion::standing::EstimatedCom` and 3 mm of margin to spare): a
+//!   CoM estimate `posture::standing::EstimatedCom` and 3 mm of margin to spare): a
 //!   planned step is one the generator expands, and no cheaper test turns away a step
 //!   that check admits (a CoM-in-triangle pre-check once came first and turned away steps
 //!   the generator expands, see `HybridGraph::step_feasible`).
@@ -187,12 +187,12 @@ use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
 use crate::geometry::Pose2;
 use crate::motion::expand::{ManoeuvreCheck, MotionError, MotionOptions};
-use crate::motion::kinematics::{Posture, hips_in_world};
-use crate::motion::standing::EstimatedCom;
 use crate::params::{Params, StepModel};
-use crate::planner::{Cost, FxBuild, SearchGraph};
+use crate::posture::kinematics::{Posture, hips_in_world};
+use crate::posture::standing::EstimatedCom;
 use crate::robot::ik::leg_ik;
 use crate::robot::{Leg, RobotDescription};
+use crate::search::{Cost, FxBuild, SearchGraph};
 use serde::Serialize;
 use std::cell::{Cell, OnceCell, RefCell};
 use std::collections::{HashMap, HashSet};

@@ -1,6 +1,6 @@
 //! The hybrid driving-stepping graph (Klamt & Behnke 2017, Sec. V and VII): the paper's
 //! "neighbour client". It turns cost queries (`cost::CostMaps`) into a
-//! [`crate::planner::SearchGraph`] that the generic A* / ARA* of `planner` search.
+//! [`crate::search::SearchGraph`] that the generic A* / ARA* of `planner` search.
 //!
 //! - [`lattice`]: discrete poses `(i, j, θ index, footprint)` on the height map's grid,
 //!   and the 16- / 20-neighbourhood driving moves.

@@ -5,7 +5,7 @@
 //!
 //! **Base cells.** A cell is *admissible* when, for some orientation of the lattice, the
 //! robot's base centred there could satisfy the two tests every state of the hybrid
-//! graph passes (`feasibility`, `motion::standing`):
+//! graph passes (`feasibility`, `posture::standing`):
 //! - the underside of the base clears the terrain under its two circles
 //!   (`DrivingCheck::body_clear`): here, the highest terrain within
 //!   [`BODY_DISC_M`] of each circle centre (less than the 0.25 m the check uses, for the
@@ -27,7 +27,7 @@
 //! A state with no such foot is cut off from the goal whatever the regions say, so the
 //! flood below only needs to be right for the others. Both postures a
 //! state stands in (the driving posture and the standing rule's) set the base by the
-//! same rule (`motion::standing::base_z`): pitched by `p`, raised until every hip stands
+//! same rule (`posture::standing::base_z`): pitched by `p`, raised until every hip stands
 //! at least the leg height `h` above its foot's ground `g_j`, one exactly; so hip `i`
 //! stands at `max_j (g_j + h + sin p · x_j) − sin p · x_i ≤ H_hi + h + |sin p| · (max x −
 //! min x)` (x the hips' x' in the base frame, their z' all one; roll is zero; a spread

@@ -4,7 +4,7 @@
 use super::*;
 use crate::geometry::Pose2;
 use crate::params::Params;
-use crate::planner::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
+use crate::search::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
 use proptest::prelude::*;
 use std::f64::consts::FRAC_PI_2;
 
@@ -250,9 +250,9 @@ mod hybrid {
     use crate::cost::CostMaps;
     use crate::geometry::Pose2;
     use crate::params::Params;
-    use crate::planner::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
     use crate::robot::{Leg, RobotDescription};
     use crate::scenario::terrain::Primitive;
+    use crate::search::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
     use crate::terrain::rasterise;
 
     fn robot() -> RobotDescription {
@@ -313,7 +313,7 @@ mod hybrid {
         options: &crate::motion::expand::MotionOptions,
         check: impl FnOnce(&mut crate::motion::expand::ManoeuvreCheck<'_>) -> T,
     ) -> T {
-        let mut model = crate::motion::standing::EstimatedCom { robot };
+        let mut model = crate::posture::standing::EstimatedCom { robot };
         check(&mut crate::motion::expand::ManoeuvreCheck {
             robot,
             maps,
@@ -634,7 +634,7 @@ mod hybrid {
         assert_eq!(i32::from(t.i - s.i), -l);
         assert!((m.length_m - f64::from(-l) * 0.025).abs() < 1e-9);
         let robot = RobotDescription::reference();
-        let rule = crate::motion::StandingRule::from_params(&Params::default());
+        let rule = crate::posture::StandingRule::from_params(&Params::default());
         let stands = |cells: i32| {
             let base = 0.505 + f64::from(s.i - state_at(&g, 0.505, 0.0).i) * 0.025;
             let x = base + f64::from(cells) * 0.025;

@@ -62,22 +62,23 @@
 //! the planner admits meets a candidate here that holds; only the CoM model differs (the
 //! planner's estimate, MuJoCo's here), and the planner keeps 3 mm of margin for that.
 
-use super::CenterOfMassModel;
 use super::keyframe::{DetailedPath, Keyframe, Phase};
-use super::kinematics;
-use super::kinematics::PostureError;
-use super::kinematics::{
-    Evaluation, Posture, contacts_in, evaluate, evaluate_legs, interpolate, rotation, solve_chains,
-};
 use super::roll::{RollError, roll_for_lateral_com};
-use super::standing::{StandingRule, StepStance, base_z_in};
 use crate::cost::CostMaps;
 use crate::feasibility::{DrivingCheck, Infeasible};
 use crate::geometry::{Pose2, wrap_angle};
 use crate::jobs::plan::{PathElement, PathKind};
 use crate::params::{Params, StepModel};
-use crate::planner::FxBuild;
+use crate::posture::CenterOfMassModel;
+use crate::posture::kinematics;
+use crate::posture::kinematics::PostureError;
+use crate::posture::kinematics::base_z_in;
+use crate::posture::kinematics::{
+    Evaluation, Posture, contacts_in, evaluate, evaluate_legs, interpolate, rotation, solve_chains,
+};
+use crate::posture::standing::{StandingRule, StepStance};
 use crate::robot::{Leg, RobotDescription};
+use crate::search::FxBuild;
 use std::collections::HashMap;
 
 /// Constants of the expansion.
@@ -403,7 +404,7 @@ impl<'a> Expander<'a> {
             if !contact[i] {
                 let h = self.robot.hips[i];
                 let b = [local[i][0] + h[0], h[1], local[i][2] + h[2]];
-                p.feet[i] = super::kinematics::apply(&r, p.base_position, b);
+                p.feet[i] = kinematics::apply(&r, p.base_position, b);
             }
         }
         p
@@ -1301,7 +1302,7 @@ type AlignmentKey = (f64, f64, f64);
 struct WheelAlignment {
     /// Leg height of the standing rule, m.
     height: f64,
-    /// How the step is stood ([`crate::motion::standing::StandingRule::step_stance`]).
+    /// How the step is stood ([`crate::posture::standing::StandingRule::step_stance`]).
     stance: StepStance,
     /// How far the partner wheel moves toward the centre, m.
     d: f64,
@@ -1324,7 +1325,7 @@ struct WheelAlignment {
 struct Alignment {
     /// Leg height of the standing rule, m.
     height: f64,
-    /// How the step is stood ([`crate::motion::standing::StandingRule::step_stance`]).
+    /// How the step is stood ([`crate::posture::standing::StandingRule::step_stance`]).
     stance: StepStance,
     /// How far the partner wheel moves toward the centre, m.
     d: f64,
@@ -1634,7 +1635,8 @@ mod tests {
                                 [x, 0.0],
                                 0.0,
                             );
-                            let mut model = super::super::standing::EstimatedCom { robot: &robot };
+                            let mut model =
+                                crate::posture::standing::EstimatedCom { robot: &robot };
                             let mut e = Expander::at(&robot, &maps, &mut model, &options, pre);
                             let r = if remember {
                                 e.expand_step_at(leg, post, search, heights)

@@ -6,7 +6,7 @@
 //! segments, where the feet stay in the neutral footprint under the moving base (wheels
 //! roll). A foot bears weight along a segment only if it does at both of its keyframes.
 
-use super::kinematics::Posture;
+use crate::posture::kinematics::Posture;
 use crate::robot::Leg;
 use serde::Serialize;
 

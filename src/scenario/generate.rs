@@ -546,7 +546,7 @@ fn in_sub(origin: [f64; 2], yaw_deg: f64, p: [f64; 2]) -> [f64; 2] {
 
 fn polyline_distance(p: [f64; 2], way: &[[f64; 2]]) -> f64 {
     way.windows(2)
-        .map(|w| crate::stability::segment_distance(p, w[0], w[1]))
+        .map(|w| crate::geometry::segment_distance(p, w[0], w[1]))
         .fold(f64::INFINITY, f64::min)
 }
 

@@ -725,7 +725,7 @@ impl RayCaster for Simulation {
 
 /// The step motion generator's CoM model: MuJoCo's own kinematics on a scratch copy of the
 /// data ([`Simulation::com_of_configuration`]), so planned and simulated CoM agree.
-impl crate::motion::CenterOfMassModel for Simulation {
+impl crate::posture::CenterOfMassModel for Simulation {
     fn com(
         &mut self,
         base_position: [f64; 3],

@@ -879,7 +879,7 @@ mod tests {
         for j in 0..ny {
             for i in 0..nx {
                 let c = hm.cell_center(i, j);
-                let d = crate::stability::segment_distance(c, [a[0], a[1]], [b[0], b[1]]);
+                let d = crate::geometry::segment_distance(c, [a[0], a[1]], [b[0], b[1]]);
                 if d <= r
                     && let Some(h) = hm.get(i, j)
                 {

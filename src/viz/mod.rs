@@ -11,9 +11,9 @@
 //! ([`Pending`]) and sent as columns; they carry the `sim_time` timeline only (no
 //! `log_tick` or `log_time`: a `log` call per sample was a quarter of a run's wall time).
 
-use crate::cost_image::RgbImage;
 use crate::geometry::Pose2;
 use crate::monitor::StabilitySample;
+use crate::render::RgbImage;
 use crate::robot::Leg;
 use crate::sim::{BodyPose, GeomKind, GeomShape};
 use crate::terrain::HeightMap;
@@ -576,7 +576,7 @@ impl Recorder {
                 .filter(|(_, c)| *c)
                 .map(|(f, _)| [f[0], f[1]])
                 .collect();
-            let mut ring: Vec<[f32; 3]> = crate::stability::convex_hull(&support)
+            let mut ring: Vec<[f32; 3]> = crate::support::convex_hull(&support)
                 .iter()
                 .map(|p| [p[0] as f32, p[1] as f32, z])
                 .collect();

@@ -5,7 +5,7 @@
 
 use super::{Command, ExecFailure, Observation, StepExecutor};
 use crate::control::wheels::WheelPairCommand;
-use crate::motion::kinematics::{Posture, contacts_in_base};
+use crate::posture::kinematics::{Posture, contacts_in_base};
 use crate::robot::ik::{IkError, ankle_of_contact, leg_ik, world_down};
 use crate::robot::{Leg, RobotDescription};
 
@@ -26,7 +26,7 @@ pub(super) fn pairs_in_base(robot: &RobotDescription, p: &Posture) -> [[f64; 2];
 /// Spare reach the executor keeps when it has to pull a foot in, m.
 pub(super) const REACH_SPARE_M: f64 = 0.001;
 
-/// Joint targets for `p` like `motion::kinematics::leg_joint_targets`, except that a foot
+/// Joint targets for `p` like `posture::kinematics::leg_joint_targets`, except that a foot
 /// beyond a leg's reach is pulled toward its hip (along the hip–ankle line) until the leg
 /// has `spare` m of reach left, and a foot closer to its hip than the knee folds is pushed
 /// out along the same line until the knee has `spare` m of fold left: the executor's
@@ -184,7 +184,7 @@ impl StepExecutor {
 mod tests {
     use super::*;
     use crate::control::step_executor::test_support::{robot, standing};
-    use crate::motion::kinematics::leg_joint_targets;
+    use crate::posture::kinematics::leg_joint_targets;
     use crate::robot::ik::leg_fk;
 
     #[test]

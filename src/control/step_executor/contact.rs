@@ -387,7 +387,7 @@ mod tests {
         let mut keys = step_path();
         for k in &mut keys {
             k.feet[0][0] = r.hips[0][0] - 0.40;
-            k.joints = crate::motion::kinematics::leg_joint_targets(&r, &k.posture()).unwrap();
+            k.joints = crate::posture::kinematics::leg_joint_targets(&r, &k.posture()).unwrap();
         }
         let cfg = ExecutorConfig { lift_settle_s: 10.0, ..config() };
         let mut ex = StepExecutor::new(&r, cfg, keys.clone(), ground());

@@ -28,7 +28,7 @@ use super::{Command, ExecFailure, Mode, Observation, StepExecutor, planar};
 use crate::control::load_sharing::{WARP_SIGN, measured_warp, target_warp};
 use crate::control::path_follower::{FollowerStatus, PathFollower};
 use crate::geometry::wrap_angle;
-use crate::motion::kinematics::{Posture, hips_in_world, interpolate};
+use crate::posture::kinematics::{Posture, hips_in_world, interpolate};
 
 /// How far a drive run moves a foot from its keyframe height to where its wheels rest,
 /// m: the foot cost's largest height difference within r_F (eq. 2), the most a wheel
@@ -45,7 +45,7 @@ impl StepExecutor {
     /// otherwise stand closer under its hip than the driving leg height (the knees fold
     /// nearly to their limit there): by the most any foot rises beyond its leg's
     /// [`Self::leg_slack`]. A driving posture sets the base by its highest foot
-    /// (`motion::kinematics::driving_posture`), so only that leg is at the driving height;
+    /// (`posture::kinematics::driving_posture`), so only that leg is at the driving height;
     /// a wheel resting on the edge of a bump the plan has it already off is taken up by
     /// its longer leg. (The base rose by each foot's whole rise before: a front pair
     /// rolling off a 4.3 cm box, its wheels still on the edge where the map had its foot
@@ -249,7 +249,7 @@ mod tests {
     use crate::control::step_executor::StepExecutor;
     use crate::control::step_executor::test_support::{config, obs, robot, standing, step_path};
     use crate::geometry::Pose2;
-    use crate::motion::kinematics::Posture;
+    use crate::posture::kinematics::Posture;
     use crate::terrain::HeightMap;
 
     /// A 4 cm bump under the front-left foot's keyframe position (hip at (0.35, 0.32),

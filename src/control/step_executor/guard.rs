@@ -16,9 +16,9 @@ use super::{
     ActiveStep, Command, ExecEventKind, ExecFailure, Mode, Observation, StepExecutor, planar,
 };
 use crate::geometry::{Pose2, wrap_angle};
-use crate::motion::kinematics::{Posture, rotation, wheel_support};
+use crate::posture::kinematics::{Posture, rotation, wheel_support};
 use crate::robot::Leg;
-use crate::stability::stability_margin;
+use crate::support::stability_margin;
 
 /// The planar offset (m) to add to a world foothold `foothold` so that, with the robot
 /// displaced from its commanded base `commanded` to the measured `measured`, a foot

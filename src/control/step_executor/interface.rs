@@ -7,11 +7,11 @@ use crate::control::foot_contact::ContactConfirmConfig;
 use crate::control::path_follower::FollowerConfig;
 use crate::control::wheels::{WheelKinematics, WheelPairCommand};
 use crate::geometry::Pose2;
-use crate::monitor::MonitorLimits;
-use crate::motion::kinematics::support_centroid;
 use crate::params::Params;
+use crate::posture::kinematics::support_centroid;
 use crate::robot::Leg;
-use crate::stability::stability_margin;
+use crate::support::MonitorLimits;
+use crate::support::stability_margin;
 use serde::Serialize;
 
 /// Gravity, m/s²: MuJoCo's default, which `models/momaro.xml` keeps.
@@ -211,7 +211,7 @@ pub struct Observation {
     /// confirms a placed foot, and what the stance compliance and the slide go by.
     pub wheel_contacts: Vec<(Leg, [f64; 2])>,
     /// Horizontal contact points of the wheels that support the robot as the monitor
-    /// counts them (within [`crate::monitor::MonitorLimits::support_gap_m`] of the terrain,
+    /// counts them (within [`crate::support::MonitorLimits::support_gap_m`] of the terrain,
     /// a superset of `wheel_contacts`): the support margins are taken over these, so the
     /// executor's margin is the monitor's.
     pub support_contacts: Vec<(Leg, [f64; 2])>,

@@ -57,7 +57,7 @@
 //!   the support triangle's centroid in bounded increments: longitudinally by a base shift,
 //!   laterally by a roll about the ground ([`correction_roll`]; the legs move only in their
 //!   sagittal planes), the roll left out where it is predicted to lose margin (a rolled
-//!   base tilts each wheel pair onto its lower wheel, `motion::kinematics::wheel_support`).
+//!   base tilts each wheel pair onto its lower wheel, `posture::kinematics::wheel_support`).
 //!   If that does not suffice, the step is aborted (the foot is not lifted).
 //! - **While a foot is in the air** the support margin is watched; below
 //!   [`ExecutorConfig::emergency_margin_m`] for [`ExecutorConfig::emergency_hold_s`] (what
@@ -119,8 +119,8 @@ pub use timing::{clock_rate, motion_duration, smoothstep, smoothstep_rate};
 use super::foot_contact::ContactConfirm;
 use super::path_follower::PathFollower;
 use crate::geometry::Pose2;
-use crate::motion::kinematics::Posture;
 use crate::motion::{Keyframe, Phase};
+use crate::posture::kinematics::Posture;
 use crate::robot::{Leg, RobotDescription};
 use crate::terrain::HeightMap;
 use actuation::{REACH_SPARE_M, held_by, reach_excess, reachable_fraction};

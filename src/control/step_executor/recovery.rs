@@ -18,7 +18,7 @@ use super::{
     AfterPutDown, Command, ExecEventKind, ExecFailure, Mode, Observation, StepExecutor, Stranding,
     planar,
 };
-use crate::motion::kinematics::{Posture, driving_posture, interpolate};
+use crate::posture::kinematics::{Posture, driving_posture, interpolate};
 use crate::robot::{Leg, RobotDescription};
 use crate::terrain::HeightMap;
 

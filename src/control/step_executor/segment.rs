@@ -11,7 +11,7 @@ use super::{
 use crate::control::foot_contact::ContactConfirm;
 use crate::geometry::wrap_angle;
 use crate::motion::Phase;
-use crate::motion::kinematics::{Posture, interpolate};
+use crate::posture::kinematics::{Posture, interpolate};
 use crate::robot::Leg;
 
 impl StepExecutor {

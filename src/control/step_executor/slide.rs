@@ -61,7 +61,7 @@ use super::{Command, ExecEventKind, ExecutorConfig, Mode, Observation, StepExecu
 use crate::control::wheels::Twist;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::motion::Phase;
-use crate::motion::kinematics::Posture;
+use crate::posture::kinematics::Posture;
 use crate::robot::{Leg, RobotDescription};
 
 /// Slide speed per metre of remaining offset, 1/s: the speed falls off over the last

@@ -4,9 +4,9 @@
 use super::{ExecutorConfig, Observation, StepExecutor};
 use crate::control::path_follower::FollowerConfig;
 use crate::geometry::Pose2;
-use crate::motion::kinematics::{Posture, leg_joint_targets};
 use crate::motion::{Keyframe, Phase};
 use crate::params::Params;
+use crate::posture::kinematics::{Posture, leg_joint_targets};
 use crate::robot::{Leg, RobotDescription};
 use crate::terrain::HeightMap;
 

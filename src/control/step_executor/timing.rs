@@ -3,7 +3,7 @@
 //! a motion at bounded linear and angular speed (recovery, lower bound of a segment).
 
 use crate::geometry::wrap_angle;
-use crate::motion::kinematics::Posture;
+use crate::posture::kinematics::Posture;
 
 /// `3s² − 2s³` on [0, 1]: zero velocity at both ends.
 pub fn smoothstep(s: f64) -> f64 {

@@ -775,7 +775,7 @@ fn time_limit_keeps_anytime_solutions() {
 /// A graph that offers dense indices for half of its states must give exactly the same
 /// search as without them (the index is only a faster look-up).
 mod dense_index {
-    use crate::planner::{Cost, SearchGraph, SearchParams, arastar, astar};
+    use crate::search::{Cost, SearchGraph, SearchParams, arastar, astar};
 
     struct Grid {
         n: i32,
@@ -818,14 +818,14 @@ mod dense_index {
                 a.solutions,
                 b.solutions
                     .iter()
-                    .map(|s| crate::planner::Solution { time: a.solutions[0].time, ..s.clone() })
+                    .map(|s| crate::search::Solution { time: a.solutions[0].time, ..s.clone() })
                     .collect::<Vec<_>>()
             );
             assert_eq!((a.expansions, a.states), (b.expansions, b.states));
             let p = SearchParams::default();
             let c = arastar(&mut Grid { n, dense: true }, (0, 0), &p).expect("params");
             let d = arastar(&mut Grid { n, dense: false }, (0, 0), &p).expect("params");
-            let costs = |r: &crate::planner::SearchResult<(i32, i32)>| {
+            let costs = |r: &crate::search::SearchResult<(i32, i32)>| {
                 r.solutions.iter().map(|s| (s.cost, s.path.clone())).collect::<Vec<_>>()
             };
             assert_eq!(costs(&c), costs(&d));

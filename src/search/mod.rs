@@ -23,7 +23,7 @@
 //!
 //! # Example
 //! ```
-//! # use momaro::planner::*;
+//! # use momaro::search::*;
 //! /// A line 0 → 1 → … → 10, each step costing one unit.
 //! struct Line;
 //! impl SearchGraph for Line {

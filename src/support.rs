@@ -6,7 +6,7 @@
 //! no area to stand on and the margin is minus the distance to the contacts' hull (a point
 //! or segment), so it is never positive.
 
-use crate::geometry::norm2;
+use crate::geometry::{norm2, segment_distance};
 
 /// Most points whose hull [`with_hull`] computes on the stack: a robot's contacts (four
 /// wheel pairs), which the planner's checks evaluate millions of times.
@@ -76,18 +76,6 @@ fn hull_into(points: &[[f64; 2]], sorted: &mut [[f64; 2]], hull: &mut [[f64; 2]]
     len
 }
 
-/// Distance from `p` to the segment from `a` to `b` in the plane.
-pub fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    norm2(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy)
-}
-
 /// Signed distance of `com` (horizontal projection) to the boundary of the convex hull of
 /// `contacts`: positive inside. `-inf` without contacts.
 pub fn stability_margin(contacts: &[[f64; 2]], com: [f64; 2]) -> f64 {
@@ -112,6 +100,49 @@ fn margin_in(hull: &[[f64; 2]], com: [f64; 2]) -> f64 {
                 nearest = nearest.min(segment_distance(com, a, b));
             }
             if inside { nearest } else { -nearest }
+        }
+    }
+}
+
+/// Limits the monitor checks against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MonitorLimits {
+    /// Roll or pitch beyond this is a tip-over, rad: steps pitch the base by at most about
+    /// 15°, so 35° is a robot falling, not climbing.
+    pub max_tilt_rad: f64,
+    /// A base sinking faster than this for [`Self::fall_duration_s`] is falling, m/s:
+    /// the controllers lower it at about 0.1 m/s.
+    pub fall_speed_m_s: f64,
+    /// How long the base must sink that fast to count as a fall, s: a wheel rolling off
+    /// a 5 cm bump drops the base at that speed for under 0.1 s; a robot tipping over or
+    /// off a step keeps falling.
+    pub fall_duration_s: f64,
+    /// A wheel whose contact MuJoCo lists this close to the terrain supports the robot,
+    /// m (the foam compresses by more than that under load; with the model's margin of
+    /// 0, MuJoCo lists a wheel's contacts only once it touches).
+    pub support_gap_m: f64,
+    /// A wheel that touched the terrain this recently still supports the robot, s.
+    pub support_memory_s: f64,
+    /// Wheels expected to support the robot (8 while driving).
+    pub expected_wheels: usize,
+    /// Samples before this time only update the wheel memory (the robot settles), s.
+    pub settle_s: f64,
+    /// A margin counts toward the run's minimum when held this long, s: longer than a
+    /// wheel's bounce off a bump edge (the support memory), short against any lean.
+    pub margin_hold_s: f64,
+}
+
+impl Default for MonitorLimits {
+    fn default() -> Self {
+        Self {
+            max_tilt_rad: 35f64.to_radians(),
+            fall_speed_m_s: 0.5,
+            fall_duration_s: 0.15,
+            support_gap_m: 0.004,
+            support_memory_s: 0.03,
+            expected_wheels: 8,
+            settle_s: 0.0,
+            margin_hold_s: 0.05,
         }
     }
 }

@@ -12,7 +12,7 @@ use super::CenterOfMassModel;
 use crate::geometry::{Pose2, norm2};
 use crate::robot::ik::{IkError, LegChain, leg_chain, leg_ik, world_down};
 use crate::robot::{Leg, RobotDescription};
-use crate::stability::{stability_margin, with_hull};
+use crate::support::{stability_margin, with_hull};
 use serde::Serialize;
 
 /// Largest lateral offset of a contact point from its hip's sagittal plane accepted for a
@@ -368,7 +368,7 @@ pub fn driving_posture(
     }
     let pitch = pitch_from_feet(&feet, pose.theta, pitch_fraction);
     let r = rotation([0.0, pitch, pose.theta]);
-    let z = super::standing::base_z_in(robot, &feet.map(|f| f[2]), &r, leg_height);
+    let z = base_z_in(robot, &feet.map(|f| f[2]), &r, leg_height);
     Ok(Posture {
         base_position: [pose.x, pose.y, z],
         base_rpy: [0.0, pitch, pose.theta],
@@ -406,6 +406,27 @@ pub fn interpolate(a: &Posture, b: &Posture, t: f64) -> Posture {
         feet: std::array::from_fn(|i| std::array::from_fn(|k| lerp(a.feet[i][k], b.feet[i][k]))),
         contact: std::array::from_fn(|i| a.contact[i] && b.contact[i]),
     }
+}
+
+/// Base origin height for the base at `rpy` such that the hip over the highest of `ground`
+/// (per leg, m) stands `height` above it and no hip stands lower above its ground.
+pub fn base_z(robot: &RobotDescription, ground: &[f64; 4], rpy: [f64; 3], height: f64) -> f64 {
+    base_z_in(robot, ground, &rotation(rpy), height)
+}
+
+/// [`base_z`] with the base rotation `r` given.
+pub(crate) fn base_z_in(
+    robot: &RobotDescription,
+    ground: &[f64; 4],
+    r: &[[f64; 3]; 3],
+    height: f64,
+) -> f64 {
+    (0..4)
+        .map(|i| {
+            let h = robot.hips[i];
+            ground[i] + height - (r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2])
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
 }
 
 #[cfg(test)]
@@ -578,7 +599,7 @@ mod tests {
                 .unwrap();
         p.base_rpy[0] = 0.02;
         p.contact[1] = false;
-        let mut model = crate::motion::LumpedMassModel::momaro_like(&robot);
+        let mut model = crate::posture::LumpedMassModel::momaro_like(&robot);
         let legs = solve_chains(&robot, &p, 0.002).unwrap();
         let e = evaluate_legs(&robot, &mut model, &p, &legs);
         assert_eq!(e, evaluate(&robot, &mut model, &p, 0.002).unwrap());

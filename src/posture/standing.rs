@@ -21,8 +21,8 @@
 
 use super::CenterOfMassModel;
 use super::kinematics::{
-    BaseFrame, Posture, PostureError, SolvedLegs, apply, contacts_in, pitch_from_feet, rotation,
-    solve_chains, solve_chains_in,
+    BaseFrame, Posture, PostureError, SolvedLegs, apply, base_z_in, contacts_in, pitch_from_feet,
+    rotation, solve_chains, solve_chains_in,
 };
 use crate::geometry::norm2;
 use crate::params::Params;
@@ -619,27 +619,6 @@ fn lumped_com(
     c.map(|v| v / total)
 }
 
-/// Base origin height for the base at `rpy` such that the hip over the highest of `ground`
-/// (per leg, m) stands `height` above it and no hip stands lower above its ground.
-pub fn base_z(robot: &RobotDescription, ground: &[f64; 4], rpy: [f64; 3], height: f64) -> f64 {
-    base_z_in(robot, ground, &rotation(rpy), height)
-}
-
-/// [`base_z`] with the base rotation `r` given.
-pub(crate) fn base_z_in(
-    robot: &RobotDescription,
-    ground: &[f64; 4],
-    r: &[[f64; 3]; 3],
-    height: f64,
-) -> f64 {
-    (0..4)
-        .map(|i| {
-            let h = robot.hips[i];
-            ground[i] + height - (r[2][0] * h[0] + r[2][1] * h[1] + r[2][2] * h[2])
-        })
-        .fold(f64::NEG_INFINITY, f64::max)
-}
-
 /// The posture with the base at `xy`, `rpy` and the height of [`base_z`]; feet not in
 /// `contact` are moved onto their legs' planes (same base-frame x' and z').
 pub fn level_posture(
@@ -683,7 +662,7 @@ fn level_posture_in(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::kinematics::solve_legs;
+    use crate::posture::kinematics::{base_z, solve_legs};
     use std::f64::consts::FRAC_PI_2;
 
     fn rule() -> StandingRule {
@@ -952,8 +931,7 @@ mod tests {
         })
         .unwrap();
         let plain = heights.dilated_max(crate::cost::LEG_TERRAIN_CELLS);
-        let wider =
-            heights.dilated_max(crate::cost::LEG_TERRAIN_CELLS + crate::feasibility::SWEEP_CELLS);
+        let wider = heights.dilated_max(crate::cost::LEG_TERRAIN_CELLS + crate::cost::SWEEP_CELLS);
         let neutral = robot.neutral_footprint();
         let mut seen = [0usize; 3];
         for n in 0..600 {

@@ -4,7 +4,7 @@
 //! unsigned 64-bit count of **micro-units** ([`Cost::SCALE`] = 10⁶ per unit of cost).
 //! With integers, sums are exact and associative, ties are real ties, and the weighted
 //! key `g + ε·h` of ARA* is computed exactly (ε is itself fixed point, see
-//! [`crate::planner::arastar`]), so a search gives the same result bit for bit on any
+//! [`crate::search::arastar`]), so a search gives the same result bit for bit on any
 //! machine. Arithmetic saturates at [`Cost::INFINITY`] (`u64::MAX`), which also stands
 //! for "impassable": the search never follows an edge of infinite cost.
 //!
