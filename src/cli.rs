@@ -279,11 +279,11 @@ pub enum StepModelArg {
 }
 
 impl PlannerArgs {
-    fn options(&self) -> jobs::plan::PlanOptions {
-        jobs::plan::PlanOptions {
+    fn options(&self) -> crate::planner::PlanOptions {
+        crate::planner::PlanOptions {
             algorithm: match self.algorithm {
-                AlgorithmArg::Astar => crate::locomotion::driving::Algorithm::AStar,
-                AlgorithmArg::Arastar => crate::locomotion::driving::Algorithm::AraStar,
+                AlgorithmArg::Astar => crate::search::Algorithm::AStar,
+                AlgorithmArg::Arastar => crate::search::Algorithm::AraStar,
             },
             time_limit_s: self.time_limit,
             initial_epsilon: self.initial_epsilon,
@@ -291,7 +291,7 @@ impl PlannerArgs {
             probe_guidance: !self.unguided_probe,
             schedule_expansions: self.schedule_expansions,
             final_epsilon: self.final_epsilon,
-            overrides: jobs::plan::ParamOverrides {
+            overrides: crate::planner::ParamOverrides {
                 k12: self.k12,
                 step_cost_factor: self.step_cost_factor,
                 foot_model: self.foot_model.map(|m| match m {
@@ -303,7 +303,7 @@ impl PlannerArgs {
                     StepModelArg::Stairs => crate::params::StepModel::Stairs,
                 }),
             },
-            ..jobs::plan::PlanOptions::default()
+            ..crate::planner::PlanOptions::default()
         }
     }
 }
@@ -460,8 +460,8 @@ fn parse_twist(s: &str) -> Result<Twist, String> {
 #[error("{0}")]
 pub struct BadInput(pub String);
 
-fn plan_error(e: jobs::plan::PlanJobError) -> anyhow::Error {
-    use jobs::plan::PlanJobError as E;
+fn plan_error(e: crate::planner::PlanError) -> anyhow::Error {
+    use crate::planner::PlanError as E;
     match e {
         E::BadOption { .. } | E::Params { .. } | E::OffMap { .. } | E::Untraversable { .. } => {
             anyhow::Error::new(BadInput(e.to_string()))
@@ -512,7 +512,7 @@ fn print_plan_failure(json: bool, scenario: &std::path::Path, e: &anyhow::Error)
         return;
     }
     let kind = e.chain().find_map(|c| {
-        if let Some(jobs::plan::PlanJobError::NoPath { termination, .. }) = c.downcast_ref() {
+        if let Some(crate::planner::PlanError::NoPath { termination, .. }) = c.downcast_ref() {
             Some(match termination {
                 crate::search::Termination::NoPath => "no_path",
                 _ => "planning_time_limit",
@@ -858,14 +858,16 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             Ok(true)
         }
         Command::Plan { scenario, planner, rerun, expansions, json, detailed: true, model } => {
-            let opts = jobs::plan::PlanOptions { expansion_image: expansions, ..planner.options() };
+            let opts = planner.options();
             let d = load(&scenario)
                 .and_then(|sc| {
                     let mut sim = crate::sim::Simulation::robot_only(&model.model)?;
-                    let d = jobs::detailed::run(&sc, &mut sim, &opts).map_err(|e| match e {
-                        jobs::detailed::DetailedJobError::Plan(p) => plan_error(p),
-                        other => anyhow::Error::new(other),
-                    })?;
+                    let image = expansions.as_deref();
+                    let d =
+                        jobs::detailed::run(&sc, &mut sim, &opts, image).map_err(|e| match e {
+                            jobs::detailed::DetailedJobError::Plan(p) => plan_error(p),
+                            other => anyhow::Error::new(other),
+                        })?;
                     Ok((sc, d))
                 })
                 .inspect_err(|e| print_plan_failure(json, &scenario, e));
@@ -892,11 +894,16 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             Ok(true)
         }
         Command::Plan { scenario, planner, rerun, expansions, json, detailed: false, model } => {
-            let opts = jobs::plan::PlanOptions { expansion_image: expansions, ..planner.options() };
+            let opts = planner.options();
             let planned = load(&scenario)
                 .and_then(|sc| {
                     let robot = robot(&model.model)?;
-                    let summary = jobs::plan::run(&sc, &robot, &opts).map_err(plan_error)?;
+                    let image = expansions.as_deref();
+                    let summary =
+                        jobs::plan::run(&sc, &robot, &opts, image).map_err(|e| match e {
+                            jobs::plan::PlanJobError::Plan(p) => plan_error(p),
+                            other => anyhow::Error::new(other),
+                        })?;
                     Ok((sc, robot, summary))
                 })
                 .inspect_err(|e| print_plan_failure(json, &scenario, e));
@@ -1051,14 +1058,14 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             run: BenchRunArgs { repeats, json, model },
         }) => {
             let sc = load(&scenario)?;
-            let opts = jobs::plan::BenchOptions {
+            let opts = jobs::bench::BenchOptions {
                 arastar_time_limit_s: arastar_limit,
                 optimum_time_limit_s: optimum_limit,
                 repeats,
                 ..Default::default()
             };
             let report =
-                jobs::plan::bench(&sc, &robot(&model.model)?, &opts).map_err(plan_error)?;
+                jobs::bench::bench(&sc, &robot(&model.model)?, &opts).map_err(plan_error)?;
             if json {
                 print_json(&report)?;
             } else {

@@ -29,7 +29,7 @@
 
 use crate::cost::CostMaps;
 use crate::geometry::Pose2;
-use crate::params::Params;
+use crate::params::{Params, StepModel};
 use crate::posture::kinematics::{self, Posture, PostureError, solve_chains};
 use crate::posture::standing::{self, StandingRule};
 use crate::robot::RobotDescription;
@@ -219,6 +219,102 @@ impl DrivingCheck {
         }
     }
 }
+
+/// Constants of the motion generator (Sec. VI) that the planner checks its manoeuvres
+/// with: the margins and the standing rule of this feasibility model, and the
+/// generator's own limits, sampling and speeds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionOptions {
+    /// Minimum static stability margin at every keyframe and interpolated point, m.
+    pub min_margin_m: f64,
+    /// Minimum margin of a posture with three feet in contact, m: the executor's lift
+    /// threshold, `Params::min_lift_margin_m` + `Params::lift_margin_reserve_m` (5 cm),
+    /// where it exceeds `min_margin_m`. The CoM estimate leaves out the sag of the
+    /// compliant support legs toward an unloaded foot; a step whose lifted phase held only
+    /// `min_margin_m` was one the executor's guard refused to lift.
+    pub min_three_contact_margin_m: f64,
+    /// With [`StepModel::Stairs`] the partner wheel stops where its leg leaves reach
+    /// (a shorter move, the rest to roll and shift); with the paper's model a candidate
+    /// whose wheel move leaves reach fails, as before (the shorter move admitted steps
+    /// with less margin to the executor's lift guard on three generated courses).
+    pub step_model: StepModel,
+    /// The standing leg-height rule (Sec. VI-B), the one the planner checks reach with.
+    pub standing: StandingRule,
+    /// Driving leg height (Sec. VI-B), m.
+    pub driving_leg_height_m: f64,
+    /// Radius of the base's two circles (Sec. IV), m.
+    pub base_circle_radius_m: f64,
+    /// Largest base roll, rad.
+    pub max_roll_rad: f64,
+    /// Largest stabilising base shift, m.
+    pub max_base_shift_m: f64,
+    /// Largest wheel-to-centre displacement, m.
+    pub max_wheel_to_centre_m: f64,
+    /// Smallest longitudinal gap between the displaced wheel pair and the stepping foot, m.
+    pub wheel_gap_m: f64,
+    /// Driving distance to the next manoeuvre from which the robot lowers in between, m.
+    pub stay_standing_m: f64,
+    /// Interpolation sample spacing, m.
+    pub sample_m: f64,
+    /// Interpolation sample spacing, rad.
+    pub sample_rad: f64,
+    /// Base and wheel speed for timing, m/s.
+    pub wheel_speed: f64,
+    /// Swing foot speed for timing, m/s.
+    pub foot_speed: f64,
+    /// Roll, pitch and yaw rate for timing, rad/s.
+    pub angular_speed: f64,
+    /// Largest shift of the zero-moment point from the CoM's ground projection that a
+    /// standing segment's own acceleration may cause where its margin has none to spare,
+    /// m; elsewhere the margin beyond the required one (see `motion::Expander::duration`).
+    pub zmp_shift_m: f64,
+}
+
+impl MotionOptions {
+    /// The paper's values from `params`, conservative speeds (0.1 m/s, 0.2 rad/s).
+    pub fn from_params(params: &Params) -> Self {
+        Self {
+            min_margin_m: params.min_stability_margin_m,
+            min_three_contact_margin_m: params.min_lift_margin_m + params.lift_margin_reserve_m,
+            step_model: params.step_model,
+            standing: StandingRule::from_params(params),
+            driving_leg_height_m: params.driving_leg_height_m,
+            base_circle_radius_m: params.base_circle_radius_m,
+            max_roll_rad: 0.2,
+            max_base_shift_m: 0.2,
+            max_wheel_to_centre_m: params.max_wheel_to_centre_m,
+            wheel_gap_m: params.wheel_gap_m,
+            stay_standing_m: 1.0,
+            sample_m: 0.01,
+            sample_rad: 0.02,
+            wheel_speed: 0.1,
+            foot_speed: 0.1,
+            angular_speed: 0.2,
+            zmp_shift_m: ZMP_SHIFT_M,
+        }
+    }
+
+    /// The least margin posture `p` must hold: [`Self::min_margin_m`], and with three feet
+    /// in contact at least [`Self::min_three_contact_margin_m`].
+    pub fn required_margin(&self, p: &Posture) -> f64 {
+        if p.contact.iter().filter(|&&c| c).count() == 3 {
+            self.min_margin_m.max(self.min_three_contact_margin_m)
+        } else {
+            self.min_margin_m
+        }
+    }
+}
+
+impl Default for MotionOptions {
+    fn default() -> Self {
+        Self::from_params(&Params::default())
+    }
+}
+
+/// Default of [`MotionOptions::zmp_shift_m`]: where a segment has no margin to spare, a
+/// third of the 3 cm the checks ask on four feet, so that braking at its ends keeps its
+/// zero-moment point at least 2 cm inside the support (`Expander::duration`).
+pub const ZMP_SHIFT_M: f64 = 0.01;
 
 #[cfg(test)]
 mod tests {

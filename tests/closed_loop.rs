@@ -3,8 +3,8 @@
 
 mod common;
 
-use momaro::jobs::plan::PlanOptions;
 use momaro::jobs::run::{PoseNoise, RunOptions, RunSummary, run};
+use momaro::planner::PlanOptions;
 
 fn run_scenario(name: &str, noise: Option<PoseNoise>) -> RunSummary {
     run_planned(name, noise, common::first_solution())
@@ -59,7 +59,7 @@ fn ramp_detour_drives_up_the_ramp_with_the_pitch_following_the_slope() {
     // optimal planner); ARA* within a time limit may stop at a first solution that steps,
     // depending on the machine's load. A* finds the optimum on any machine.
     let plan = PlanOptions {
-        algorithm: momaro::locomotion::Algorithm::AStar,
+        algorithm: momaro::search::Algorithm::AStar,
         time_limit_s: 600.0,
         ..PlanOptions::default()
     };

@@ -5,7 +5,7 @@
 mod common;
 
 use momaro::jobs::generate::{GenerateOptions, checked_case, run};
-use momaro::jobs::plan::prepare;
+use momaro::planner::prepare;
 use momaro::robot::RobotDescription;
 use momaro::scenario::Scenario;
 use momaro::scenario::generate::Class;

@@ -3,10 +3,10 @@
 
 mod common;
 
-use momaro::jobs::plan::PlanOptions;
 use momaro::jobs::run::{RunOptions, run};
 use momaro::jobs::stand_at_start;
 use momaro::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor, TipCause};
+use momaro::planner::PlanOptions;
 use momaro::robot::Leg;
 use momaro::sim::Simulation;
 

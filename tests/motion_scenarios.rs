@@ -11,8 +11,11 @@ mod common;
 
 use common::{first_solution, probe_path};
 
-use momaro::jobs::plan::{self, PathElement, PathKind, PlanOptions, PlanSummary};
-use momaro::motion::{DetailedPath, MotionError, MotionOptions, Phase, ZMP_SHIFT_M, expand_path};
+use momaro::feasibility::{MotionOptions, ZMP_SHIFT_M};
+use momaro::motion::{DetailedPath, MotionError, Phase, expand_path};
+use momaro::path::ManoeuvreKind;
+use momaro::path::PathElement;
+use momaro::planner::{self, PlanOptions, PlanSummary};
 use momaro::robot::Leg;
 use momaro::scenario::Scenario;
 use momaro::sim::{Simulation, default_model_path};
@@ -33,7 +36,7 @@ fn expand(
     path: &[PathElement],
 ) -> Result<DetailedPath, MotionError> {
     let robot = sim.robot().clone();
-    let prep = plan::prepare(s, &robot, Default::default()).expect("maps");
+    let prep = planner::prepare(s, &robot, Default::default()).expect("maps");
     let options = MotionOptions::from_params(&prep.params);
     expand_path(path, &robot, &prep.maps, sim, &options)
 }
@@ -85,7 +88,7 @@ fn before_rear_step_up(p: &PlanSummary, n: usize) -> usize {
         .iter()
         .enumerate()
         .filter(|(_, e)| {
-            e.kind == PathKind::Step
+            e.kind == ManoeuvreKind::Step
                 && e.leg.is_some_and(|l| !l.is_front())
                 && e.step.is_some_and(|s| s.height_m > 0.05)
         })
@@ -144,7 +147,7 @@ fn whole_path_checked(
 ) -> (Scenario, Simulation, PlanSummary, DetailedPath) {
     let s = scenario(name);
     let mut sim = sim();
-    let p = plan::run(&s, sim.robot(), opts).expect("plan");
+    let p = planner::run(&s, sim.robot(), opts).expect("plan");
     let d = expand(&s, &mut sim, &p.path).expect("expansion");
     report(&s, p.path.len(), p.path.len(), &d);
     check(&d, &sim);
@@ -184,13 +187,13 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
     // The path up to its first step, with a margin no step can keep, fails at that step,
     // naming it and its leg.
     let robot = sim.robot().clone();
-    let prep = plan::prepare(&s, &robot, Default::default()).expect("maps");
+    let prep = planner::prepare(&s, &robot, Default::default()).expect("maps");
     // 25 cm: the four-wheel postures before it keep more (about 0.3 m), no three-wheel
     // posture can: the support triangles the feet can form have inscribed circles of at
     // most about 0.24 m. (At 15 cm, since the swing clears only what the wheels pass, a
     // candidate of the generator's full search keeps the margin.)
     let options = MotionOptions { min_margin_m: 0.25, ..MotionOptions::from_params(&prep.params) };
-    let first = p.path.iter().position(|e| e.kind == PathKind::Step).expect("a step");
+    let first = p.path.iter().position(|e| e.kind == ManoeuvreKind::Step).expect("a step");
     match expand_path(&p.path[..=first], &robot, &prep.maps, &mut sim, &options) {
         Err(MotionError::Step { index, leg, best_margin_m, required_m, .. }) => {
             assert_eq!(index, first);
@@ -236,10 +239,10 @@ height = 0.1
     let s = Scenario::parse(text, Path::new("blocked_wheel.toml")).expect("scenario");
     let mut sim = sim();
     let robot = sim.robot().clone();
-    let prep = plan::prepare(&s, &robot, Default::default()).expect("maps");
+    let prep = planner::prepare(&s, &robot, Default::default()).expect("maps");
     let neutral = robot.neutral_footprint();
     let start = PathElement {
-        kind: PathKind::Start,
+        kind: ManoeuvreKind::Start,
         leg: None,
         pose: momaro::geometry::Pose2::new(0.0, 0.0, 0.0),
         feet: neutral,
@@ -251,7 +254,7 @@ height = 0.1
     let mut feet = neutral;
     feet[0][0] += 0.3;
     let step = PathElement {
-        kind: PathKind::Step,
+        kind: ManoeuvreKind::Step,
         leg: Some(Leg::FrontLeft),
         feet,
         foot_offsets_m: [0.3, 0.0, 0.0, 0.0],
@@ -306,7 +309,7 @@ fn expand_generated_up_and_over(dir: &str, seeds: &[u64], opts: &PlanOptions) {
     for &seed in seeds {
         let (case, _) = checked_case(Class::UpAndOver, seed, &dir, &robot).expect("generated");
         let s = case.scenario(&dir).expect("scenario");
-        let p = plan::run(&s, sim.robot(), opts).expect("plan");
+        let p = planner::run(&s, sim.robot(), opts).expect("plan");
         assert!(p.steps >= 8, "{}: {} steps planned", s.name, p.steps);
         let d = expand(&s, &mut sim, &p.path).unwrap_or_else(|e| panic!("{}: {e}", s.name));
         report(&s, p.path.len(), p.path.len(), &d);

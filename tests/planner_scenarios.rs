@@ -7,13 +7,13 @@
 //! first solution or its probe's path. No outcome depends on the machine's speed.
 
 use momaro::geometry::Pose2;
-use momaro::jobs::plan::{
-    self, ParamOverrides, PathElement, PathKind, PlanJobError, PlanOptions, PlanSummary, run,
-};
-use momaro::locomotion::Algorithm;
 use momaro::params::{FootModel, StepModel};
+use momaro::path::ManoeuvreKind;
+use momaro::path::PathElement;
+use momaro::planner::{self, ParamOverrides, PlanError, PlanOptions, PlanSummary, run};
 use momaro::robot::RobotDescription;
 use momaro::scenario::Scenario;
+use momaro::search::Algorithm;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -62,14 +62,14 @@ fn staircase_probe_path() -> &'static PlanSummary {
 }
 
 fn steps(p: &PlanSummary) -> Vec<&PathElement> {
-    p.path.iter().filter(|e| e.kind == PathKind::Step).collect()
+    p.path.iter().filter(|e| e.kind == ManoeuvreKind::Step).collect()
 }
 
 /// Angle between heading and driving direction of every drive, weighted by length.
 fn mean_drive_angle(p: &PlanSummary) -> f64 {
     let (mut sum, mut len) = (0.0, 0.0);
     for w in p.path.windows(2) {
-        if w[1].kind != PathKind::Drive {
+        if w[1].kind != ManoeuvreKind::Drive {
             continue;
         }
         let (dx, dy) = (w[1].pose.x - w[0].pose.x, w[1].pose.y - w[0].pose.y);
@@ -82,14 +82,11 @@ fn mean_drive_angle(p: &PlanSummary) -> f64 {
 }
 
 /// A plan that found no path before its expansion cap stopped it.
-fn assert_stopped_by_expansion_limit(result: &Result<PlanSummary, PlanJobError>, what: &str) {
+fn assert_stopped_by_expansion_limit(result: &Result<PlanSummary, PlanError>, what: &str) {
     assert!(
         matches!(
             result,
-            Err(PlanJobError::NoPath {
-                termination: momaro::search::Termination::ExpansionLimit,
-                ..
-            })
+            Err(PlanError::NoPath { termination: momaro::search::Termination::ExpansionLimit, .. })
         ),
         "{what}: {result:?}"
     );
@@ -138,7 +135,7 @@ fn poles_low_one_passes_between_the_legs_tall_one_avoided() {
     check_solutions(&p);
     assert_eq!(p.steps, 0);
     let (low, tall) = ([1.6, 0.0], [3.6, 0.0]);
-    let local = |e: &momaro::jobs::plan::PathElement, c: [f64; 2]| {
+    let local = |e: &momaro::path::PathElement, c: [f64; 2]| {
         let (sn, cs) = e.pose.theta.sin_cos();
         let (dx, dy) = (c[0] - e.pose.x, c[1] - e.pose.y);
         [cs * dx + sn * dy, -sn * dx + cs * dy]
@@ -185,11 +182,11 @@ fn staircase_climbs_then_takes_the_bar_between_its_legs() {
     let p = staircase_probe_path();
     check_solutions(p);
     assert!(p.steps >= 8, "climbs the stairs: {} steps", p.steps);
-    let last_step = p.path.iter().rposition(|e| e.kind == PathKind::Step).expect("steps");
+    let last_step = p.path.iter().rposition(|e| e.kind == ManoeuvreKind::Step).expect("steps");
     // The climb ends on the landing (0.36 m); from there the robot only drives.
     let top = &p.path[last_step];
     assert!(top.foot_heights.iter().all(|h| h.is_some_and(|h| h > 0.3)));
-    assert!(p.path[last_step + 1..].iter().all(|e| !matches!(e.kind, PathKind::Step)));
+    assert!(p.path[last_step + 1..].iter().all(|e| !matches!(e.kind, ManoeuvreKind::Step)));
     // The landing is too shallow to turn on, so along the bar (x = 3.45 m, y from
     // −0.5 m; checked from y = 0, once the robot has squared up) the robot drives sideways
     // as in the paper's Fig. 12: heading along +x, moving along +y, front wheels beyond the
@@ -230,7 +227,7 @@ fn flights_longer_than_the_robot_need_the_stairs_step_model() {
     s.map.x_max = 2.7; // a smaller map, the goal on the landing: the search ends sooner
     s.goal.x = 2.0;
     match run(&s, &robot(), &first_solution()) {
-        Err(PlanJobError::NoPath { .. }) => {}
+        Err(PlanError::NoPath { .. }) => {}
         other => panic!("expected no path with the paper's step model: {other:?}"),
     }
     // Three steps are climbed with either model, and descended with the stairs model.
@@ -336,9 +333,9 @@ fn plans_on_one_prepared_world_share_its_heuristic_and_find_the_same_path() {
     let robot = robot();
     let opts = first_solution();
     let alone = plan(&s, &opts);
-    let prep = plan::prepare_for(&s, &robot, &opts).expect("maps");
-    let first = plan::run_on(&prep, &s, &robot, &opts).expect("plan");
-    let again = plan::run_on(&prep, &s, &robot, &opts).expect("plan");
+    let prep = planner::prepare_for(&s, &robot, &opts).expect("maps");
+    let first = planner::run_on(&prep, &s, &robot, &opts).expect("plan");
+    let again = planner::run_on(&prep, &s, &robot, &opts).expect("plan");
     assert!(!alone.heuristic.reused && !first.heuristic.reused);
     assert!(again.heuristic.reused);
     assert_eq!(again.heuristic.setup_time_s, 0.0);
@@ -352,8 +349,8 @@ fn plans_on_one_prepared_world_share_its_heuristic_and_find_the_same_path() {
     let other =
         PlanOptions { overrides: ParamOverrides { k12: Some(1.0), ..Default::default() }, ..opts };
     assert!(matches!(
-        plan::run_on(&prep, &s, &robot, &other),
-        Err(PlanJobError::BadOption { option: "prepared", .. })
+        planner::run_on(&prep, &s, &robot, &other),
+        Err(PlanError::BadOption { option: "prepared", .. })
     ));
 }
 
@@ -363,13 +360,13 @@ fn plans_on_one_prepared_world_share_its_heuristic_and_find_the_same_path() {
 #[test]
 fn bench_times_the_first_path_cold_and_on_warm_tables() {
     let s = scenario("flat");
-    let opts = plan::BenchOptions {
+    let opts = momaro::jobs::bench::BenchOptions {
         arastar_time_limit_s: 10.0,
         optimum_time_limit_s: 60.0,
         k12: None,
         repeats: 1,
     };
-    let report = plan::bench(&s, &robot(), &opts).expect("bench");
+    let report = momaro::jobs::bench::bench(&s, &robot(), &opts).expect("bench");
     let probe = report.rows.iter().find(|r| r.algorithm == "arastar+probe").expect("probe row");
     assert!(probe.first_solution_s.is_some());
     assert!(probe.first_solution_warm_s.is_some());
@@ -389,25 +386,25 @@ fn a_replan_starts_from_the_nearest_pose_a_plan_can_start_from() {
     ));
     let robot = robot();
     assert!(matches!(
-        plan::prepare(&walled, &robot, Default::default()),
-        Err(PlanJobError::Untraversable { .. })
+        planner::prepare(&walled, &robot, Default::default()),
+        Err(PlanError::Untraversable { .. })
     ));
     // The run's world is prepared from a start clear of the wall; the robot then stops
     // at the scenario's start, next to it.
     let mut clear = walled.clone();
     clear.start = Pose2::new(walled.start.x, walled.start.y - 0.3, walled.start.theta);
-    let mut prep = plan::prepare(&clear, &robot, Default::default()).expect("clear of the wall");
+    let mut prep = planner::prepare(&clear, &robot, Default::default()).expect("clear of the wall");
     assert!(matches!(
         prep.set_start(&walled, &robot, walled.start),
-        Err(PlanJobError::Untraversable { which: "start", .. })
+        Err(PlanError::Untraversable { which: "start", .. })
     ));
-    let start = plan::nearest_start(&prep, &robot, walled.start, 0.15);
+    let start = planner::nearest_start(&prep, &robot, walled.start, 0.15);
     let moved = start.distance(&walled.start);
     assert!(moved > 0.0 && moved <= 0.15 + 1e-9, "moved {moved}");
     prep.set_start(&walled, &robot, start).expect("a plan starts there");
     assert_eq!(prep.start, prep.lattice.state(&start).expect("on the map"));
     // Where a plan can start, the start is kept.
-    assert_eq!(plan::nearest_start(&prep, &robot, clear.start, 0.15), clear.start);
+    assert_eq!(planner::nearest_start(&prep, &robot, clear.start, 0.15), clear.start);
 }
 
 #[test]
@@ -419,14 +416,14 @@ fn bad_poses_and_unreachable_goals_are_clear_errors_within_the_time_limit() {
         "{base}\n[[terrain]]\nkind = \"box\"\ncenter = [0.0, 0.5]\nsize = [2.0, 0.1]\nheight = 0.5\n"
     );
     match run(&parse(&walled), &robot(), &arastar(10.0)) {
-        Err(PlanJobError::Untraversable { which, .. }) => assert_eq!(which, "start"),
+        Err(PlanError::Untraversable { which, .. }) => assert_eq!(which, "start"),
         other => panic!("{other:?}"),
     }
     // Start at the map's edge: the wheels reach off the map (unknown).
     let edge = base.clone().replacen("x = 0.0\ny = 0.0", "x = -2.95\ny = 0.0", 1);
     assert!(matches!(
         run(&parse(&edge), &robot(), &arastar(10.0)),
-        Err(PlanJobError::Untraversable { .. })
+        Err(PlanError::Untraversable { .. })
     ));
     // Goal boxed in by 0.4 m walls (too high to step over from outside): no path, and
     // the search says so rather than hanging.
@@ -459,7 +456,7 @@ height = 0.4
     let r = run(&parse(&boxed), &robot(), &arastar(5.0));
     assert!(t0.elapsed().as_secs_f64() < 7.0, "time limit overrun");
     match r {
-        Err(PlanJobError::NoPath { .. }) => {}
+        Err(PlanError::NoPath { .. }) => {}
         other => panic!("{other:?}"),
     }
     // A tiny time limit holds on the platform.
@@ -467,11 +464,11 @@ height = 0.4
     let r = run(&scenario("platform"), &robot(), &arastar(0.05));
     assert!(t0.elapsed().as_secs_f64() < 1.0, "time limit overrun");
     if let Err(e) = r {
-        assert!(matches!(e, PlanJobError::NoPath { .. }), "{e}");
+        assert!(matches!(e, PlanError::NoPath { .. }), "{e}");
     }
     // Invalid options.
     let bad = PlanOptions { time_limit_s: f64::NAN, ..PlanOptions::default() };
-    assert!(matches!(run(&scenario("flat"), &robot(), &bad), Err(PlanJobError::BadOption { .. })));
+    assert!(matches!(run(&scenario("flat"), &robot(), &bad), Err(PlanError::BadOption { .. })));
 }
 
 /// ARA*'s probe (issue 15): on a generated up-and-over course (`generate --class

@@ -16,9 +16,10 @@ use common::{first_solution, probe_path};
 
 use momaro::control::step_executor::{ExecEventKind, ExecFailure};
 use momaro::jobs::envelope::{self, Direction};
-use momaro::jobs::plan::{self, PathKind, PlanOptions, PlanSummary};
 use momaro::jobs::run::{self, Mission, Push, PushWhen, RunOptions, RunSummary};
 use momaro::motion::{DetailedPath, Phase};
+use momaro::path::ManoeuvreKind;
+use momaro::planner::{self, PlanOptions, PlanSummary};
 use momaro::robot::Leg;
 use momaro::scenario::Scenario;
 use momaro::sim::Simulation;
@@ -38,7 +39,7 @@ fn prefix_end(p: &PlanSummary, end: End) -> usize {
         .iter()
         .enumerate()
         .filter(|(_, e)| {
-            e.kind == PathKind::Step
+            e.kind == ManoeuvreKind::Step
                 && e.leg.is_some_and(|l| l.is_front())
                 && e.step.is_some_and(|s| s.height_m > 0.05)
         })
@@ -82,15 +83,15 @@ fn execute_prefix(sc: &Scenario, end: End, push: Option<Push>) -> RunSummary {
     let wall = Instant::now();
     let mut sim = Simulation::new(sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
-    let mut prep = plan::prepare_for(sc, &robot, &first_solution()).expect("maps");
-    let plan = plan::run_on(&prep, sc, &robot, &first_solution()).expect("plan");
+    let mut prep = planner::prepare_for(sc, &robot, &first_solution()).expect("maps");
+    let plan = planner::run_on(&prep, sc, &robot, &first_solution()).expect("plan");
     let mut end = prefix_end(&plan, end);
     assert!(end < plan.path.len(), "the prefix ends before the goal");
     // Without the planned base shift that prepares a rear step up: it moves the base
     // forward and down with the front feet on higher ground, and the generator, which
     // checks reach, joint limits and stability but not leg–terrain collisions, folds the
     // front legs onto the tread (MuJoCo: thigh and shin touch it).
-    if plan.path[end - 1].kind == PathKind::BaseShift {
+    if plan.path[end - 1].kind == ManoeuvreKind::BaseShift {
         end -= 1;
     }
     let detailed = prefix_keyframes(sc, &mut sim, &plan, end);
@@ -146,7 +147,7 @@ fn stepped(s: &RunSummary) -> Vec<Leg> {
 
 /// The 1-based number, in plan order, of the first step of `leg` onto higher ground.
 fn first_step_up(p: &PlanSummary, leg: Leg) -> usize {
-    let steps = p.path.iter().filter(|e| e.kind == PathKind::Step);
+    let steps = p.path.iter().filter(|e| e.kind == ManoeuvreKind::Step);
     1 + steps
         .take_while(|e| !(e.leg == Some(leg) && e.step.is_some_and(|s| s.height_m > 0.05)))
         .count()
@@ -165,7 +166,7 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
     // step was aborted (measured with an earlier plan).
     let robot = Simulation::robot_only(&common::model()).expect("model").robot().clone();
     let step =
-        first_step_up(&plan::run(&sc, &robot, &first_solution()).expect("plan"), Leg::FrontLeft);
+        first_step_up(&planner::run(&sc, &robot, &first_solution()).expect("plan"), Leg::FrontLeft);
     let push = Push {
         when: PushWhen::Step { step, phase: Phase::Swing, delay_s: 1.0 },
         force: [0.0, 300.0, 0.0],
@@ -448,12 +449,12 @@ fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) 
     let wall = Instant::now();
     let mut sim = Simulation::new(&sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
-    let plan = plan::run(&planned, &robot, &opts.plan).expect("plan");
+    let plan = planner::run(&planned, &robot, &opts.plan).expect("plan");
     let detailed =
         run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
     momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
     // Replans (if any) plan with the executor's parameters.
-    let mut prep = plan::prepare_for(&sc, &robot, &first_solution()).expect("maps");
+    let mut prep = planner::prepare_for(&sc, &robot, &first_solution()).expect("maps");
     let mission = Mission { plan, detailed };
     let s = run::execute(&sc, &mut prep, &mut sim, mission, &opts, wall).expect("runs");
     (s, sim)

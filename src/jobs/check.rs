@@ -24,8 +24,8 @@
 //! of a run (or a panic) is a [`Verdict::Error`] row with the error chain. The rest of the
 //! suite runs either way.
 
-use super::plan::PlanJobError;
 use super::run::{self, FailureKind, RunJobError, RunOptions, RunSummary};
+use crate::planner::PlanError;
 use crate::scenario::Scenario;
 use serde::{Serialize, Serializer};
 use std::collections::{BTreeMap, BTreeSet};
@@ -504,10 +504,10 @@ fn is_input_error(e: &RunJobError) -> bool {
     matches!(
         e,
         RunJobError::Plan(
-            PlanJobError::BadOption { .. }
-                | PlanJobError::Params { .. }
-                | PlanJobError::OffMap { .. }
-                | PlanJobError::Untraversable { .. }
+            PlanError::BadOption { .. }
+                | PlanError::Params { .. }
+                | PlanError::OffMap { .. }
+                | PlanError::Untraversable { .. }
         )
     )
 }

@@ -1,8 +1,9 @@
 //! `momaro plan --detailed`: plan, then expand the abstract path into stable keyframes
 //! (step motion generation, Sec. VI) with MuJoCo's CoM.
 
-use super::plan::{self, PlanJobError, PlanOptions, PlanSummary};
-use crate::motion::{DetailedPath, MotionError, MotionOptions, expand_path};
+use crate::feasibility::MotionOptions;
+use crate::motion::{DetailedPath, MotionError, expand_path};
+use crate::planner::{self, PlanError, PlanOptions, PlanSummary};
 use crate::scenario::Scenario;
 use crate::sim::Simulation;
 use serde::Serialize;
@@ -12,7 +13,10 @@ use serde::Serialize;
 pub enum DetailedJobError {
     /// Planning failed.
     #[error(transparent)]
-    Plan(#[from] PlanJobError),
+    Plan(#[from] PlanError),
+    /// The expansion image could not be written.
+    #[error(transparent)]
+    Image(#[from] crate::render::ImageError),
     /// The expansion failed.
     #[error("scenario {scenario}: step motion generation")]
     Motion {
@@ -32,18 +36,29 @@ pub struct DetailedSummary {
     pub detailed: DetailedPath,
 }
 
-/// Plans `scenario` and expands the path, with the CoM of `sim`'s model.
+/// Plans `scenario` and expands the path, with the CoM of `sim`'s model; with
+/// `expansion_image`, writes where the search went as `momaro plan` does.
 ///
 /// # Errors
-/// [`DetailedJobError`] if planning or the expansion fails.
+/// [`DetailedJobError`] if planning or the expansion fails or the image cannot be written.
 pub fn run(
     scenario: &Scenario,
     sim: &mut Simulation,
     opts: &PlanOptions,
+    expansion_image: Option<&std::path::Path>,
 ) -> Result<DetailedSummary, DetailedJobError> {
     let robot = sim.robot().clone();
-    let prep = plan::prepare_for(scenario, &robot, opts)?;
-    let plan = plan::run_on(&prep, scenario, &robot, opts)?;
+    let prep = planner::prepare_for(scenario, &robot, opts)?;
+    let mut counts = None;
+    let plan = planner::plan::run_on_counted(
+        &prep,
+        scenario,
+        &robot,
+        opts,
+        expansion_image.map(|_| &mut counts),
+    );
+    super::plan::write_counts(expansion_image, counts.as_ref())?;
+    let plan = plan?;
     let detailed = expand_prefix_on(&prep, scenario, sim, &plan, plan.path.len())?;
     Ok(DetailedSummary { plan, detailed })
 }
@@ -71,16 +86,16 @@ pub fn expand_prefix(
     plan: &PlanSummary,
     end: usize,
 ) -> Result<DetailedPath, DetailedJobError> {
-    let prep = plan::prepare(scenario, sim.robot(), plan::ParamOverrides::of_plan(plan))?;
+    let prep = planner::prepare(scenario, sim.robot(), planner::ParamOverrides::of_plan(plan))?;
     expand_prefix_on(&prep, scenario, sim, plan, end)
 }
 
-/// [`expand_prefix`] on the world `prep` the plan was made on (`plan::run_on`).
+/// [`expand_prefix`] on the world `prep` the plan was made on (`planner::run_on`).
 ///
 /// # Errors
 /// [`DetailedJobError::Motion`] if the expansion fails.
 pub fn expand_prefix_on(
-    prep: &plan::Prepared,
+    prep: &planner::Prepared,
     scenario: &Scenario,
     sim: &mut Simulation,
     plan: &PlanSummary,

@@ -499,7 +499,7 @@ mod tests {
             out_dir: PathBuf::from("/nonexistent"),
             check: CheckOptions {
                 run: crate::jobs::run::RunOptions::new(
-                    crate::jobs::plan::PlanOptions::default(),
+                    crate::planner::PlanOptions::default(),
                     PathBuf::from("m.xml"),
                 ),
                 jobs: 1,

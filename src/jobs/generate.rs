@@ -3,11 +3,11 @@
 //!
 //! Case i of a run uses seed S + i alone and, without a class, class i mod 8; so any one
 //! file is reproducible with `--class C --seed S --count 1`. A draw whose start or goal
-//! the planner would refuse (`plan::prepare`: the driving footprint on an infinite or
+//! the planner would refuse (`planner::prepare`: the driving footprint on an infinite or
 //! unknown foot cost) is replaced by the next draw of the same seed's stream, up to
 //! [`MAX_TRIES`] draws. Every case is generated and checked before any file is written.
 
-use super::plan;
+use crate::planner;
 use crate::robot::RobotDescription;
 use crate::scenario::generate::{Class, Draws, GenerateError, GeneratedCase};
 use crate::scenario::{Outcome, Scenario};
@@ -129,7 +129,7 @@ pub fn checked_case(
         let path = dir.join(case.file_name());
         match Scenario::parse(&text, &path) {
             Ok(scenario) => {
-                match plan::prepare(&scenario, robot, plan::ParamOverrides::default()) {
+                match planner::prepare(&scenario, robot, planner::ParamOverrides::default()) {
                     Ok(_) => return Ok((case, text)),
                     Err(e) => reason = format!("draw {}: {e}", case.draw),
                 }

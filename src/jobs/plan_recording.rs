@@ -3,8 +3,9 @@
 //! foothold (front steps red, rear steps green, as in the paper's Fig. 11).
 
 use super::costmap::{CostmapError, rasterised_map};
-use super::plan::{PathKind, PlanSummary};
 use crate::cost::CostMaps;
+use crate::path::ManoeuvreKind;
+use crate::planner::PlanSummary;
 use crate::render;
 use crate::robot::RobotDescription;
 use crate::scenario::Scenario;
@@ -57,7 +58,7 @@ pub fn step_lines(summary: &PlanSummary) -> Vec<([f64; 3], [f64; 3], bool)> {
     let mut steps = Vec::new();
     for pair in summary.path.windows(2) {
         let (before, after) = (&pair[0], &pair[1]);
-        if after.kind == PathKind::Step
+        if after.kind == ManoeuvreKind::Step
             && let Some(leg) = after.leg
         {
             let i = leg.index();

@@ -15,7 +15,6 @@
 //! decide the verdict.
 
 use super::detailed::DetailedJobError;
-use super::plan::{self, PlanJobError, PlanOptions, PlanSummary, Prepared};
 use super::sim::{CONTROL_HZ, SETTLE_S};
 use crate::control::path_follower::FollowerConfig;
 use crate::control::step_executor::{
@@ -24,6 +23,7 @@ use crate::control::step_executor::{
 use crate::geometry::{Pose2, wrap_angle};
 use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor, StabilitySample};
 use crate::motion::{DetailedPath, MotionError, Phase};
+use crate::planner::{self, PlanError, PlanOptions, PlanSummary, Prepared};
 use crate::progress::SimProgress;
 use crate::rng::Rng;
 use crate::robot::Leg;
@@ -42,7 +42,7 @@ use std::time::Instant;
 pub enum RunJobError {
     /// Planning failed.
     #[error(transparent)]
-    Plan(#[from] PlanJobError),
+    Plan(#[from] PlanError),
     /// The plan could not be expanded into keyframes (step motion generation).
     #[error("{scenario}: step motion generation")]
     Motion {
@@ -71,6 +71,9 @@ pub enum RunJobError {
     /// The recording failed.
     #[error(transparent)]
     Viz(#[from] VizError),
+    /// An image could not be written.
+    #[error(transparent)]
+    Image(#[from] crate::render::ImageError),
 }
 
 /// Seeded noise on the measured base pose.
@@ -452,7 +455,7 @@ pub struct Mission {
     pub detailed: DetailedPath,
 }
 
-/// Plans `scenario` on the world `prep` (`plan::prepare_for` with `opts`) from its start
+/// Plans `scenario` on the world `prep` (`planner::prepare_for` with `opts`) from its start
 /// and expands the path with `sim`'s CoM model.
 ///
 /// # Errors
@@ -464,7 +467,7 @@ pub fn plan_mission(
     opts: &PlanOptions,
 ) -> Result<Mission, RunJobError> {
     let robot = sim.robot().clone();
-    let mut plan = plan::run_on(prep, scenario, &robot, opts)?;
+    let mut plan = planner::run_on(prep, scenario, &robot, opts)?;
     let mut planning_time_s = plan.planning_time_s;
     // The planner and the generator share one feasibility model, but the generator
     // checks every centimetre of a manoeuvre the planner checks at its stances: what it
@@ -497,7 +500,7 @@ pub fn plan_mission(
             return Err(original);
         };
         retry.forbidden.push(e);
-        match plan::run_on(prep, scenario, &robot, &retry) {
+        match planner::run_on(prep, scenario, &robot, &retry) {
             Ok(p) => {
                 planning_time_s += p.planning_time_s;
                 plan = p;
@@ -534,6 +537,7 @@ impl From<DetailedJobError> for RunJobError {
     fn from(e: DetailedJobError) -> Self {
         match e {
             DetailedJobError::Plan(e) => RunJobError::Plan(e),
+            DetailedJobError::Image(e) => RunJobError::Image(e),
             DetailedJobError::Motion { scenario, source } => {
                 RunJobError::Motion { scenario, source }
             }
@@ -550,7 +554,7 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
     let mut sim = Simulation::new(scenario, &opts.model_path)?;
     // One world for the run: every plan (retries, replans), the generator and the
     // recording use its maps, and the plans share its heuristic toward the goal.
-    let mut prep = plan::prepare_for(scenario, sim.robot(), &opts.plan)?;
+    let mut prep = planner::prepare_for(scenario, sim.robot(), &opts.plan)?;
     let mission = match plan_mission(&prep, scenario, &mut sim, &opts.plan) {
         Ok(m) => m,
         Err(e) => return unexecuted(scenario, e, wall),
@@ -567,7 +571,7 @@ fn unexecuted(
     wall: Instant,
 ) -> Result<RunSummary, RunJobError> {
     let kind = match &e {
-        RunJobError::Plan(PlanJobError::NoPath { termination, .. }) => match termination {
+        RunJobError::Plan(PlanError::NoPath { termination, .. }) => match termination {
             crate::search::Termination::NoPath => FailureKind::NoPath,
             _ => FailureKind::PlanningTimeLimit,
         },
@@ -652,7 +656,7 @@ fn log_mission(r: &Recorder, m: &Mission) -> Result<(), VizError> {
 }
 
 /// Executes `mission` in `sim` from its current state (the robot standing at the plan's
-/// start), replanning on the world `prep` (`plan::prepare_for` with `opts.plan`, which the
+/// start), replanning on the world `prep` (`planner::prepare_for` with `opts.plan`, which the
 /// mission was planned on) when the executor leaves the plan; `wall` is when the job
 /// started.
 ///
@@ -755,7 +759,8 @@ pub fn execute(
                 replans += 1;
                 let t = Instant::now();
                 let mut from_here = scenario.clone();
-                from_here.start = plan::nearest_start(prep, &robot, truth, REPLAN_START_RADIUS_M);
+                from_here.start =
+                    planner::nearest_start(prep, &robot, truth, REPLAN_START_RADIUS_M);
                 let replan_opts =
                     PlanOptions { time_limit_s: opts.replan_time_limit_s, ..opts.plan.clone() };
                 let result = prep

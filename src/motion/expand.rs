@@ -65,10 +65,10 @@
 use super::keyframe::{DetailedPath, Keyframe, Phase};
 use super::roll::{RollError, roll_for_lateral_com};
 use crate::cost::CostMaps;
-use crate::feasibility::{DrivingCheck, Infeasible};
+use crate::feasibility::{DrivingCheck, Infeasible, MotionOptions};
 use crate::geometry::{Pose2, wrap_angle};
-use crate::jobs::plan::{PathElement, PathKind};
-use crate::params::{Params, StepModel};
+use crate::params::StepModel;
+use crate::path::{ManoeuvreKind, PathElement};
 use crate::posture::CenterOfMassModel;
 use crate::posture::kinematics;
 use crate::posture::kinematics::PostureError;
@@ -76,99 +76,10 @@ use crate::posture::kinematics::base_z_in;
 use crate::posture::kinematics::{
     Evaluation, Posture, contacts_in, evaluate, evaluate_legs, interpolate, rotation, solve_chains,
 };
-use crate::posture::standing::{StandingRule, StepStance};
+use crate::posture::standing::StepStance;
 use crate::robot::{Leg, RobotDescription};
 use crate::search::FxBuild;
 use std::collections::HashMap;
-
-/// Constants of the expansion.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MotionOptions {
-    /// Minimum static stability margin at every keyframe and interpolated point, m.
-    pub min_margin_m: f64,
-    /// Minimum margin of a posture with three feet in contact, m: the executor's lift
-    /// threshold, `Params::min_lift_margin_m` + `Params::lift_margin_reserve_m` (5 cm),
-    /// where it exceeds `min_margin_m`. The CoM estimate leaves out the sag of the
-    /// compliant support legs toward an unloaded foot; a step whose lifted phase held only
-    /// `min_margin_m` was one the executor's guard refused to lift.
-    pub min_three_contact_margin_m: f64,
-    /// With [`StepModel::Stairs`] the partner wheel stops where its leg leaves reach
-    /// (a shorter move, the rest to roll and shift); with the paper's model a candidate
-    /// whose wheel move leaves reach fails, as before (the shorter move admitted steps
-    /// with less margin to the executor's lift guard on three generated courses).
-    pub step_model: StepModel,
-    /// The standing leg-height rule (Sec. VI-B), the one the planner checks reach with.
-    pub standing: StandingRule,
-    /// Driving leg height (Sec. VI-B), m.
-    pub driving_leg_height_m: f64,
-    /// Radius of the base's two circles (Sec. IV), m.
-    pub base_circle_radius_m: f64,
-    /// Largest base roll, rad.
-    pub max_roll_rad: f64,
-    /// Largest stabilising base shift, m.
-    pub max_base_shift_m: f64,
-    /// Largest wheel-to-centre displacement, m.
-    pub max_wheel_to_centre_m: f64,
-    /// Smallest longitudinal gap between the displaced wheel pair and the stepping foot, m.
-    pub wheel_gap_m: f64,
-    /// Driving distance to the next manoeuvre from which the robot lowers in between, m.
-    pub stay_standing_m: f64,
-    /// Interpolation sample spacing, m.
-    pub sample_m: f64,
-    /// Interpolation sample spacing, rad.
-    pub sample_rad: f64,
-    /// Base and wheel speed for timing, m/s.
-    pub wheel_speed: f64,
-    /// Swing foot speed for timing, m/s.
-    pub foot_speed: f64,
-    /// Roll, pitch and yaw rate for timing, rad/s.
-    pub angular_speed: f64,
-    /// Largest shift of the zero-moment point from the CoM's ground projection that a
-    /// standing segment's own acceleration may cause where its margin has none to spare,
-    /// m; elsewhere the margin beyond the required one (see [`Expander::duration`]).
-    pub zmp_shift_m: f64,
-}
-
-impl MotionOptions {
-    /// The paper's values from `params`, conservative speeds (0.1 m/s, 0.2 rad/s).
-    pub fn from_params(params: &Params) -> Self {
-        Self {
-            min_margin_m: params.min_stability_margin_m,
-            min_three_contact_margin_m: params.min_lift_margin_m + params.lift_margin_reserve_m,
-            step_model: params.step_model,
-            standing: StandingRule::from_params(params),
-            driving_leg_height_m: params.driving_leg_height_m,
-            base_circle_radius_m: params.base_circle_radius_m,
-            max_roll_rad: 0.2,
-            max_base_shift_m: 0.2,
-            max_wheel_to_centre_m: params.max_wheel_to_centre_m,
-            wheel_gap_m: params.wheel_gap_m,
-            stay_standing_m: 1.0,
-            sample_m: 0.01,
-            sample_rad: 0.02,
-            wheel_speed: 0.1,
-            foot_speed: 0.1,
-            angular_speed: 0.2,
-            zmp_shift_m: ZMP_SHIFT_M,
-        }
-    }
-
-    /// The least margin posture `p` must hold: [`Self::min_margin_m`], and with three feet
-    /// in contact at least [`Self::min_three_contact_margin_m`].
-    pub fn required_margin(&self, p: &Posture) -> f64 {
-        if p.contact.iter().filter(|&&c| c).count() == 3 {
-            self.min_margin_m.max(self.min_three_contact_margin_m)
-        } else {
-            self.min_margin_m
-        }
-    }
-}
-
-impl Default for MotionOptions {
-    fn default() -> Self {
-        Self::from_params(&Params::default())
-    }
-}
 
 /// Why a path cannot be expanded.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -236,18 +147,6 @@ enum AlignmentError {
     Posture(#[from] PostureError),
     #[error(transparent)]
     Roll(#[from] RollError),
-}
-
-fn kind_name(k: PathKind) -> &'static str {
-    match k {
-        PathKind::Start => "start",
-        PathKind::Drive => "drive",
-        PathKind::Turn => "turn",
-        PathKind::Step => "step",
-        PathKind::BaseShift => "base_shift",
-        PathKind::FootForward => "foot_forward",
-        PathKind::FootNeutral => "foot_neutral",
-    }
 }
 
 /// A segment that passed: its end evaluation, smallest margins and sample count.
@@ -636,17 +535,17 @@ impl<'a> Expander<'a> {
         self.keys.extend(keys);
     }
 
-    fn push(&mut self, kind: PathKind, seq: &[Planned]) -> Result<(), MotionError> {
+    fn push(&mut self, kind: ManoeuvreKind, seq: &[Planned]) -> Result<(), MotionError> {
         let (k, mm, m3, s) = self.trial(seq).map_err(|f| MotionError::Manoeuvre {
             index: self.index,
-            kind: kind_name(kind),
+            kind: kind.name(),
             reason: f.to_string(),
         })?;
         self.commit(k, mm, m3, s);
         Ok(())
     }
 
-    fn stand_up(&mut self, kind: PathKind) -> Result<(), MotionError> {
+    fn stand_up(&mut self, kind: ManoeuvreKind) -> Result<(), MotionError> {
         let (feet, xy, yaw) = (self.cur.feet, self.xy(), self.cur.base_rpy[2]);
         let p = self.stand_for(kind, feet, xy, yaw)?;
         self.push(kind, &[(Phase::StandUp, None, p)])
@@ -656,7 +555,7 @@ impl<'a> Expander<'a> {
     /// manoeuvre.
     fn stand_for(
         &mut self,
-        kind: PathKind,
+        kind: ManoeuvreKind,
         feet: [[f64; 3]; 4],
         xy: [f64; 2],
         yaw: f64,
@@ -664,7 +563,7 @@ impl<'a> Expander<'a> {
         let index = self.index;
         self.standing_fallback(feet, xy, yaw).map_err(|reason| MotionError::Manoeuvre {
             index,
-            kind: kind_name(kind),
+            kind: kind.name(),
             reason,
         })
     }
@@ -1090,7 +989,7 @@ impl<'a> Expander<'a> {
     /// wheel move and planned base shift starts from that posture, the one the planner
     /// checks it from ([`ManoeuvreCheck`]), whatever the manoeuvre before left (a roll-back
     /// at another leg height, a base re-centred on its feet).
-    fn settle(&mut self, kind: PathKind, pose: &Pose2) -> Result<(), MotionError> {
+    fn settle(&mut self, kind: ManoeuvreKind, pose: &Pose2) -> Result<(), MotionError> {
         let p = self.stand_for(kind, self.cur.feet, [pose.x, pose.y], pose.theta)?;
         if p != self.cur {
             self.push(kind, &[(Phase::StandUp, None, p)])?;
@@ -1106,7 +1005,7 @@ impl<'a> Expander<'a> {
     /// dip a knee below the legs' clearance that both ends kept.
     fn expand_wheel_move(
         &mut self,
-        kind: PathKind,
+        kind: ManoeuvreKind,
         leg: Leg,
         foot: [f64; 2],
     ) -> Result<(), MotionError> {
@@ -1135,7 +1034,7 @@ impl<'a> Expander<'a> {
     /// footprint (the wheels roll that far), so both agree on every later reach.
     fn expand_base_shift(
         &mut self,
-        kind: PathKind,
+        kind: ManoeuvreKind,
         feet: [[f64; 2]; 4],
         to: &Pose2,
     ) -> Result<(), MotionError> {
@@ -1261,7 +1160,7 @@ impl ManoeuvreCheck<'_> {
         leg: Leg,
         foot: [f64; 2],
     ) -> Result<(), MotionError> {
-        self.expander(pre).expand_wheel_move(PathKind::FootForward, leg, foot)
+        self.expander(pre).expand_wheel_move(ManoeuvreKind::FootForward, leg, foot)
     }
 
     /// A planned base shift to pose `to` over feet `feet` (x, y: the footprint at the
@@ -1275,7 +1174,7 @@ impl ManoeuvreCheck<'_> {
         feet: [[f64; 2]; 4],
         to: &Pose2,
     ) -> Result<(), MotionError> {
-        self.expander(pre).expand_base_shift(PathKind::BaseShift, feet, to)
+        self.expander(pre).expand_base_shift(ManoeuvreKind::BaseShift, feet, to)
     }
 }
 
@@ -1411,14 +1310,16 @@ pub fn expand_path(
         options.min_margin_m,
         options.base_circle_radius_m,
     );
-    let special = |k: PathKind| !matches!(k, PathKind::Start | PathKind::Drive | PathKind::Turn);
+    let special = |k: ManoeuvreKind| {
+        !matches!(k, ManoeuvreKind::Start | ManoeuvreKind::Drive | ManoeuvreKind::Turn)
+    };
     let mut standing = false;
     let mut steps = 0;
     for (k, el) in path.iter().enumerate().skip(1) {
         ex.index = k;
         match el.kind {
-            PathKind::Start => {}
-            PathKind::Drive | PathKind::Turn => {
+            ManoeuvreKind::Start => {}
+            ManoeuvreKind::Drive | ManoeuvreKind::Turn => {
                 if standing {
                     // Lower if the next manoeuvre is far (or there is none).
                     let mut dist = 0.0;
@@ -1463,28 +1364,28 @@ pub fn expand_path(
                 };
                 ex.push(el.kind, &[(Phase::Drive, None, target)])?;
             }
-            PathKind::Step
-            | PathKind::BaseShift
-            | PathKind::FootForward
-            | PathKind::FootNeutral => {
+            ManoeuvreKind::Step
+            | ManoeuvreKind::BaseShift
+            | ManoeuvreKind::FootForward
+            | ManoeuvreKind::FootNeutral => {
                 if !standing {
                     ex.stand_up(el.kind)?;
                     standing = true;
                 }
                 let bad = |reason: String| MotionError::Manoeuvre {
                     index: k,
-                    kind: kind_name(el.kind),
+                    kind: el.kind.name(),
                     reason,
                 };
                 match (el.kind, el.leg) {
-                    (PathKind::Step, Some(leg)) => {
+                    (ManoeuvreKind::Step, Some(leg)) => {
                         ex.settle(el.kind, &path[k - 1].pose)?;
                         let f = el.feet[leg.index()];
                         let post_foot = [f[0], f[1], ex.ground(f[0], f[1])?];
                         ex.expand_step(leg, post_foot)?;
                         steps += 1;
                     }
-                    (PathKind::BaseShift, _) => {
+                    (ManoeuvreKind::BaseShift, _) => {
                         ex.settle(el.kind, &path[k - 1].pose)?;
                         ex.expand_base_shift(el.kind, el.feet, &el.pose)?;
                     }
@@ -1508,7 +1409,7 @@ pub fn expand_path(
         // Where the driving posture does not fit (the planner admitted the goal standing),
         // the robot finishes standing.
         if check.posture_ok(&p, maps, maps.leg_terrain()).is_ok() {
-            ex.push(PathKind::Drive, &[(Phase::Lower, None, p)])?;
+            ex.push(ManoeuvreKind::Drive, &[(Phase::Lower, None, p)])?;
         }
     }
     let min_keyframe = ex.keys.iter().map(|k| k.margin_m).fold(f64::INFINITY, f64::min);
@@ -1522,11 +1423,6 @@ pub fn expand_path(
         keyframes: ex.keys,
     })
 }
-
-/// Default of [`MotionOptions::zmp_shift_m`]: where a segment has no margin to spare, a
-/// third of the 3 cm the checks ask on four feet, so that braking at its ends keeps its
-/// zero-moment point at least 2 cm inside the support (`Expander::duration`).
-pub const ZMP_SHIFT_M: f64 = 0.01;
 
 /// Standard gravity, m/s².
 const GRAVITY: f64 = 9.81;
@@ -1548,6 +1444,7 @@ fn zmp_duration(b: &Posture, coms: [[f64; 3]; 2], shift: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::Params;
 
     #[test]
     fn a_posture_on_three_feet_needs_the_lift_threshold() {

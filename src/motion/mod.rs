@@ -12,6 +12,6 @@ pub mod expand;
 pub mod keyframe;
 pub mod roll;
 
-pub use expand::{MotionError, MotionOptions, ZMP_SHIFT_M, expand_path};
+pub use expand::{MotionError, expand_path};
 pub use keyframe::{DetailedPath, Keyframe, Phase};
 pub use roll::{RollError, RollSolution, roll_for_lateral_com};

@@ -58,7 +58,7 @@ pub use astar::{astar, astar_with_hooks};
 pub use cost::Cost;
 pub use graph::SearchGraph;
 pub use nodes::{FxBuild, FxHasher};
-pub use params::{EPS_SCALE, ParamsError, SearchParams};
+pub use params::{Algorithm, EPS_SCALE, ParamsError, SearchParams};
 pub use result::{
     ExpandHook, Expansion, Hooks, SearchError, SearchResult, Solution, SolutionHook, Termination,
 };

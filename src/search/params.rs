@@ -196,6 +196,15 @@ pub(crate) fn eps_to_f64(eps_milli: u64) -> f64 {
     eps_milli as f64 / EPS_SCALE as f64
 }
 
+/// Which search to run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Algorithm {
+    /// Optimal A*.
+    AStar,
+    /// Anytime ARA* with the ε schedule of the search parameters.
+    AraStar,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

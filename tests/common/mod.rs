@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use momaro::jobs::plan::PlanOptions;
+use momaro::planner::PlanOptions;
 use momaro::scenario::Scenario;
 use std::path::PathBuf;
 

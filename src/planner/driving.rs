@@ -39,8 +39,8 @@ use super::orientation::OrientationFactor;
 use crate::geometry::Pose2;
 use crate::params::Params;
 use crate::search::{
-    Cost, Hooks, SearchError, SearchGraph, SearchParams, SearchResult, arastar_with_hooks,
-    astar_with_hooks,
+    Algorithm, Cost, Hooks, SearchError, SearchGraph, SearchParams, SearchResult,
+    arastar_with_hooks, astar_with_hooks,
 };
 
 /// Where driving pose costs come from: the cost client (`cost::CostMaps`), or a stand-in
@@ -371,15 +371,6 @@ pub enum DrivingPlanError {
     /// The search parameters are invalid.
     #[error(transparent)]
     Search(#[from] SearchError),
-}
-
-/// Which search to run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Algorithm {
-    /// Optimal A*.
-    AStar,
-    /// Anytime ARA* with the ε schedule of the search parameters.
-    AraStar,
 }
 
 /// Plans a driving path from `start` to `goal` (poses snapped to the lattice; the goal

@@ -185,9 +185,11 @@ use super::reachability::{BaseRegions, StanceLimits};
 use super::way::WayField;
 use crate::cost::{Cost as CostValue, CostMaps, HeadingBin};
 use crate::feasibility::DrivingCheck;
+use crate::feasibility::MotionOptions;
 use crate::geometry::Pose2;
-use crate::motion::expand::{ManoeuvreCheck, MotionError, MotionOptions};
+use crate::motion::expand::{ManoeuvreCheck, MotionError};
 use crate::params::{Params, StepModel};
+use crate::path::{EdgeLabel, ManoeuvreKind, StepCost};
 use crate::posture::kinematics::{Posture, hips_in_world};
 use crate::posture::standing::EstimatedCom;
 use crate::robot::ik::leg_ik;
@@ -199,63 +201,9 @@ use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
-/// What an edge of the hybrid graph does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ManoeuvreKind {
-    /// A straight driving move in the neutral footprint (Fig. 4 left).
-    Drive,
-    /// A turn on the spot to the next orientation (Fig. 4 right).
-    Turn,
-    /// An abstract step of one foot (Fig. 6a).
-    Step,
-    /// A longitudinal base shift (Fig. 6b).
-    BaseShift,
-    /// A front wheel pair driven forward to prepare a rear step (Fig. 6c).
-    FootForward,
-    /// A wheel pair driven back to its neutral position (Fig. 6d).
-    FootNeutral,
-}
-
-impl ManoeuvreKind {
-    /// Whether the manoeuvre is step-related (its cost carries the step-related factor).
-    pub fn is_step_related(self) -> bool {
-        !matches!(self, ManoeuvreKind::Drive | ManoeuvreKind::Turn)
-    }
-}
-
 /// A foothold of a step by the scan (`HybridGraph::step_candidates`): C_S, the offset
 /// change in cells, the cost terms and the foothold (x, y, ground z).
 type StepCandidate = (f64, i32, StepCost, [f64; 3]);
-
-/// The parts of a step's cost C_S (eq. 5).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct StepCost {
-    /// L_step, m.
-    pub length_m: f64,
-    /// C_F(c_h), the foot cost of the foothold (eq. 1).
-    pub foothold_cost: f64,
-    /// ΔH_step, m: the largest height difference the foot overcomes.
-    pub height_m: f64,
-    /// C_S (eq. 5), before the step-related factor.
-    pub c_s: f64,
-}
-
-/// One edge of the hybrid graph, labelled.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Manoeuvre {
-    /// What it does.
-    pub kind: ManoeuvreKind,
-    /// The leg that moves (steps and foot moves).
-    pub leg: Option<Leg>,
-    /// Distance: base travel (drive, base shift), wheel travel (turn, foot moves) or the
-    /// step length, m.
-    pub length_m: f64,
-    /// The edge cost as searched, in cost units (before fixed-point rounding).
-    pub cost: f64,
-    /// The parts of C_S, for steps.
-    pub step: Option<StepCost>,
-}
 
 /// C_S = k7 · L_step + k8 · (C_F(c_h) − 1) + k9 · ΔH_step (eq. 5), before the
 /// step-related factor.
@@ -361,8 +309,8 @@ struct FootMove {
 }
 
 impl FootMove {
-    fn manoeuvre(&self) -> Manoeuvre {
-        Manoeuvre {
+    fn manoeuvre(&self) -> EdgeLabel {
+        EdgeLabel {
             kind: self.kind,
             leg: Some(self.leg),
             length_m: self.length_m,
@@ -537,7 +485,7 @@ pub struct HybridGraph<'c> {
     /// [`GREEDY_OFFSET_PER_M`] per lattice cell.
     greedy_offset_per_cell: Cost,
     /// Scratch buffer for the labelled special successors.
-    special: Vec<(LatticeState, Cost, Manoeuvre)>,
+    special: Vec<(LatticeState, Cost, EdgeLabel)>,
     /// The counters; a `Cell`, as the step checks are counted in `step_feasible`, which
     /// takes `&self`.
     stats: Cell<ManoeuvreStats>,
@@ -1957,9 +1905,9 @@ impl<'c> HybridGraph<'c> {
 
     /// A step of leg `k` with cost terms `step`: its edge cost (C_S times the
     /// step-related factor) and label.
-    fn step_edge(&self, k: usize, step: StepCost) -> (Cost, Manoeuvre) {
+    fn step_edge(&self, k: usize, step: StepCost) -> (Cost, EdgeLabel) {
         let cost = self.config.step_cost_factor * step.c_s;
-        let m = Manoeuvre {
+        let m = EdgeLabel {
             kind: ManoeuvreKind::Step,
             leg: Some(Leg::ALL[k]),
             length_m: step.length_m,
@@ -1979,7 +1927,7 @@ impl<'c> HybridGraph<'c> {
         feet: &Feet,
         k: usize,
         candidates: Vec<StepCandidate>,
-    ) -> Option<(LatticeState, Cost, Manoeuvre)> {
+    ) -> Option<(LatticeState, Cost, EdgeLabel)> {
         let (o2, step) = self.best_step(s, o, feet, k, candidates)?;
         let t = self.with_footprint(s, o2)?;
         self.count(|c| &mut c.steps);
@@ -1990,7 +1938,7 @@ impl<'c> HybridGraph<'c> {
     /// The successor of an intermediate node `p` (see "Lazy step checks" in the module
     /// docs): its step, checked now, at the rest of its cost (the full cost less what
     /// the edge into `p` charged). `None` when no foothold passes the checks.
-    fn pending_step(&mut self, p: LatticeState) -> Option<(LatticeState, Cost, Manoeuvre)> {
+    fn pending_step(&mut self, p: LatticeState) -> Option<(LatticeState, Cost, EdgeLabel)> {
         let k = usize::from(p.step_pending.checked_sub(1)?);
         let s = LatticeState { step_pending: 0, ..p };
         let o = self.footprints.get(s.footprint)?;
@@ -2222,7 +2170,7 @@ impl<'c> HybridGraph<'c> {
         self.special.push((
             t,
             edge_cost(cost),
-            Manoeuvre {
+            EdgeLabel {
                 kind: ManoeuvreKind::BaseShift,
                 leg: None,
                 length_m: moved,
@@ -2233,7 +2181,7 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// Every successor of `s` with its cost and label, in the search's order.
-    pub fn labelled_successors(&mut self, s: LatticeState) -> Vec<(LatticeState, Cost, Manoeuvre)> {
+    pub fn labelled_successors(&mut self, s: LatticeState) -> Vec<(LatticeState, Cost, EdgeLabel)> {
         let mut out = Vec::new();
         if s.footprint == NEUTRAL_FOOTPRINT && s.step_pending == 0 {
             let mut plain = Vec::new();
@@ -2242,7 +2190,7 @@ impl<'c> HybridGraph<'c> {
             for (t, c) in plain {
                 let b = self.lattice.pose(t);
                 let m = if (t.i, t.j) == (s.i, s.j) {
-                    Manoeuvre {
+                    EdgeLabel {
                         kind: ManoeuvreKind::Turn,
                         leg: None,
                         length_m: self.driving.config().turn_radius_m
@@ -2251,7 +2199,7 @@ impl<'c> HybridGraph<'c> {
                         step: None,
                     }
                 } else {
-                    Manoeuvre {
+                    EdgeLabel {
                         kind: ManoeuvreKind::Drive,
                         leg: None,
                         length_m: a.distance(&b),
@@ -2272,7 +2220,7 @@ impl<'c> HybridGraph<'c> {
     }
 
     /// The cheapest edge from `s` to `t`, labelled; `None` if there is none.
-    pub fn edge(&mut self, s: LatticeState, t: LatticeState) -> Option<(Cost, Manoeuvre)> {
+    pub fn edge(&mut self, s: LatticeState, t: LatticeState) -> Option<(Cost, EdgeLabel)> {
         self.labelled_successors(s)
             .into_iter()
             .filter(|(u, _, _)| *u == t)

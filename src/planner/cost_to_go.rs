@@ -706,8 +706,8 @@ impl Buckets {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::locomotion::lattice::Neighbourhood;
     use crate::params::Params;
+    use crate::planner::lattice::Neighbourhood;
     use crate::robot::RobotDescription;
     use crate::scenario::Primitive;
     use crate::terrain::rasterise;

@@ -4,7 +4,7 @@
 use super::*;
 use crate::geometry::Pose2;
 use crate::params::Params;
-use crate::search::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
+use crate::search::{Algorithm, Cost, SearchGraph, SearchParams, Termination, arastar, astar};
 use proptest::prelude::*;
 use std::f64::consts::FRAC_PI_2;
 
@@ -250,6 +250,7 @@ mod hybrid {
     use crate::cost::CostMaps;
     use crate::geometry::Pose2;
     use crate::params::Params;
+    use crate::path::{EdgeLabel, ManoeuvreKind};
     use crate::robot::{Leg, RobotDescription};
     use crate::scenario::terrain::Primitive;
     use crate::search::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
@@ -295,7 +296,7 @@ mod hybrid {
         // 0.98 m up, and the regions let the base over it (the search took 958 k
         // expansions, 15 s, to prove no path). No foot climbs 0.98 m, so the step bound
         // is infinite there, and such ground now does not count.
-        let prims = crate::locomotion::reachability::tests::doorway(0.31, 0.29, 0.98);
+        let prims = crate::planner::reachability::tests::doorway(0.31, 0.29, 0.98);
         let m = rasterise(&prims, [-1.0, -2.0], [6.0, 4.0], 0.025).expect("map");
         let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
         let (i, j) = maps.heights().cell_of(2.0, 1.0).expect("on the map");
@@ -310,7 +311,7 @@ mod hybrid {
     fn with_generator<T>(
         robot: &RobotDescription,
         maps: &CostMaps,
-        options: &crate::motion::expand::MotionOptions,
+        options: &crate::feasibility::MotionOptions,
         check: impl FnOnce(&mut crate::motion::expand::ManoeuvreCheck<'_>) -> T,
     ) -> T {
         let mut model = crate::posture::standing::EstimatedCom { robot };
@@ -326,7 +327,7 @@ mod hybrid {
     fn step_edges(
         g: &mut HybridGraph<'_>,
         s: LatticeState,
-    ) -> Vec<(LatticeState, Cost, Manoeuvre)> {
+    ) -> Vec<(LatticeState, Cost, EdgeLabel)> {
         let mut all = g.labelled_successors(s);
         all.retain(|(_, _, m)| m.kind == ManoeuvreKind::Step);
         all
@@ -824,7 +825,7 @@ mod hybrid {
             SearchParams { initial_epsilon: 3.0, final_epsilon: 3.0, ..SearchParams::default() };
         let r = arastar(&mut g, start, &search).expect("valid params");
         let best = r.best().unwrap_or_else(|| panic!("no path: {:?}", r.termination));
-        let labels: Vec<Manoeuvre> =
+        let labels: Vec<EdgeLabel> =
             best.path.windows(2).filter_map(|w| g.edge(w[0], w[1]).map(|(_, m)| m)).collect();
         let steps = labels.iter().filter(|m| m.kind == ManoeuvreKind::Step).count();
         assert_eq!(steps, 4, "every foot steps down once");
@@ -936,7 +937,7 @@ mod hybrid {
             let f = g.feet(s).expect("feet");
             f.map(|p| g.height_at(p[0], p[1]).expect("on the map"))
         };
-        let labels: Vec<Manoeuvre> =
+        let labels: Vec<EdgeLabel> =
             best.path.windows(2).filter_map(|w| g.edge(w[0], w[1]).map(|(_, m)| m)).collect();
         let mid_flight_shift = (0..labels.len()).any(|i| {
             let next_step = (i + 1..labels.len()).find(|&k| labels[k].kind == ManoeuvreKind::Step);
@@ -1104,7 +1105,7 @@ mod hybrid {
     fn check_consistent(
         g: &mut HybridGraph<'_>,
         s: LatticeState,
-    ) -> Vec<(LatticeState, Cost, Manoeuvre)> {
+    ) -> Vec<(LatticeState, Cost, EdgeLabel)> {
         let succ = g.labelled_successors(s);
         for &(t, c, m) in &succ {
             let (hs, ht) = (g.heuristic(s), g.heuristic(t));

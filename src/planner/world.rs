@@ -1,0 +1,283 @@
+//! The world a plan is searched on, built once per job: the scenario's height map
+//! rasterised (2.5 cm), the cost maps (Sec. IV), the lattice over them, the start and goal
+//! states checked (on the map, and poses the robot can stand at), and the heuristic tables
+//! of the job's searches toward its goal ([`HeuristicCache`]). A run's plans (the first,
+//! the generator's retries, the replans from where the robot stopped) share one
+//! [`Prepared`] world.
+
+use super::options::{ParamOverrides, PlanError, PlanOptions};
+use super::{
+    DrivingGoal, HeuristicCache, HybridConfig, HybridGraph, Lattice, LatticeError, LatticeState,
+    Neighbourhood,
+};
+use crate::cost::{Cost as CostValue, CostMaps};
+use crate::geometry::Pose2;
+use crate::params::Params;
+use crate::robot::RobotDescription;
+use crate::scenario::Scenario;
+use crate::terrain::rasterise;
+use serde::Serialize;
+use std::time::Instant;
+
+/// Grid of the plan.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MapInfo {
+    /// World position of the corner of cell (0, 0), m.
+    pub origin: [f64; 2],
+    /// Cell size, m.
+    pub resolution: f64,
+    /// Cells along x.
+    pub nx: usize,
+    /// Cells along y.
+    pub ny: usize,
+    /// Orientations per cell.
+    pub orientations: u32,
+}
+
+/// Cost maps, lattice states of start and goal and the parameters of one scenario, and
+/// the heuristic tables the job's searches built: what every search of a job shares.
+pub struct Prepared {
+    /// The parameters with the options' overrides.
+    pub params: Params,
+    /// The cost client.
+    pub maps: CostMaps,
+    /// The lattice over the maps.
+    pub lattice: Lattice,
+    /// Start state (neutral footprint).
+    pub start: LatticeState,
+    /// Goal state (neutral footprint).
+    pub goal: LatticeState,
+    /// Time spent building, s.
+    pub setup_time_s: f64,
+    /// The heuristic tables of the searches on these maps ([`run_on`]'s graphs).
+    pub heuristics: HeuristicCache,
+}
+
+impl Prepared {
+    /// Moves the start to `start` (a replan from where the robot stands), checked as
+    /// [`prepare`] checks `scenario`'s.
+    ///
+    /// # Errors
+    /// [`PlanError::OffMap`] or [`PlanError::Untraversable`] naming `scenario`.
+    pub fn set_start(
+        &mut self,
+        scenario: &Scenario,
+        robot: &RobotDescription,
+        start: Pose2,
+    ) -> Result<(), PlanError> {
+        let world = (&self.maps, &self.lattice);
+        self.start = endpoint(scenario, robot, &self.params, world, "start", start)?;
+        Ok(())
+    }
+
+    /// The hybrid graph for this scenario with `neighbourhood` and k12 = `k12`.
+    ///
+    /// # Errors
+    /// A map too large for the lattice.
+    pub fn graph(
+        &self,
+        robot: &RobotDescription,
+        neighbourhood: Neighbourhood,
+        k12: f64,
+    ) -> Result<HybridGraph<'_>, LatticeError> {
+        let params = Params { k12, ..self.params.clone() };
+        let config = HybridConfig::new(&params, robot, neighbourhood);
+        HybridGraph::new(
+            &self.maps,
+            robot,
+            self.params.orientations,
+            config,
+            DrivingGoal::at(self.goal),
+        )
+    }
+
+    /// The map grid.
+    pub fn map_info(&self) -> MapInfo {
+        let hm = self.maps.heights();
+        let (nx, ny) = hm.dims();
+        MapInfo {
+            origin: hm.origin(),
+            resolution: hm.resolution(),
+            nx,
+            ny,
+            orientations: self.params.orientations,
+        }
+    }
+}
+
+/// Builds the height map and cost maps of `scenario` and checks its start and goal.
+///
+/// # Errors
+/// Invalid parameters, an unbuildable map, or a start / goal off the map or on
+/// untraversable terrain.
+pub fn prepare(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    overrides: ParamOverrides,
+) -> Result<Prepared, PlanError> {
+    let t0 = Instant::now();
+    let params = params_for(scenario, overrides)?;
+    let (maps, lattice) = build_maps(scenario, robot, &params)?;
+    let endpoint = |which, pose| endpoint(scenario, robot, &params, (&maps, &lattice), which, pose);
+    let start = endpoint("start", scenario.start)?;
+    let goal = endpoint("goal", scenario.goal)?;
+    Ok(Prepared {
+        start,
+        goal,
+        params,
+        maps,
+        lattice,
+        setup_time_s: t0.elapsed().as_secs_f64(),
+        heuristics: HeuristicCache::default(),
+    })
+}
+
+/// [`prepare`] with the overrides of `opts` (as [`run`] prepares).
+///
+/// # Errors
+/// As [`prepare`].
+pub fn prepare_for(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    opts: &PlanOptions,
+) -> Result<Prepared, PlanError> {
+    prepare(scenario, robot, opts.overrides)
+}
+
+/// The lattice state of `scenario`'s `which` pose `pose`, checked: on the map, and one
+/// the robot can stand at ([`unfit`]).
+pub(crate) fn endpoint(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    params: &Params,
+    (maps, lattice): (&CostMaps, &Lattice),
+    which: &'static str,
+    pose: Pose2,
+) -> Result<LatticeState, PlanError> {
+    let file = || scenario.path.clone();
+    let Some(s) = lattice.state(&pose) else {
+        return Err(PlanError::OffMap {
+            scenario: file(),
+            which,
+            pose,
+            bounds: maps.heights().bounds(),
+        });
+    };
+    if let Some(reason) = unfit(robot, params, maps, &lattice.pose(s)) {
+        return Err(PlanError::Untraversable { scenario: file(), which, pose, reason });
+    }
+    Ok(s)
+}
+
+/// The scenario's parameters with the options' overrides, validated.
+pub(crate) fn params_for(
+    scenario: &Scenario,
+    overrides: ParamOverrides,
+) -> Result<Params, PlanError> {
+    let params = overrides.apply(scenario.params.clone());
+    params
+        .validate()
+        .map_err(|source| PlanError::Params { scenario: scenario.path.clone(), source })?;
+    Ok(params)
+}
+
+/// The height and cost maps of `scenario` with `params`, and the lattice over them.
+fn build_maps(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    params: &Params,
+) -> Result<(CostMaps, crate::planner::Lattice), PlanError> {
+    let file = || scenario.path.clone();
+    let m = &scenario.map;
+    let heights = rasterise(
+        &scenario.terrain,
+        [m.x_min, m.y_min],
+        [m.x_max - m.x_min, m.y_max - m.y_min],
+        params.grid_resolution_m,
+    )
+    .map_err(|source| PlanError::Map { scenario: file(), source })?;
+    let maps = CostMaps::build(&heights, robot, params)
+        .map_err(|source| PlanError::Cost { scenario: file(), source })?;
+    let lattice = crate::planner::Lattice::for_map(maps.heights(), params.orientations)
+        .map_err(|source| PlanError::Lattice { scenario: file(), source })?;
+    Ok((maps, lattice))
+}
+
+/// Why the robot cannot start or end at lattice pose `pose`, if it cannot: the driving
+/// pose cost must be finite and the feasibility model must fit the robot there.
+pub(crate) fn unfit(
+    robot: &RobotDescription,
+    params: &Params,
+    maps: &CostMaps,
+    pose: &Pose2,
+) -> Option<&'static str> {
+    match maps.driving_pose_cost(pose) {
+        CostValue::Finite(_)
+            if crate::feasibility::DrivingCheck::new(robot, params)
+                .lattice_pose(maps, pose)
+                .is_ok() =>
+        {
+            None
+        }
+        CostValue::Finite(_) => Some(
+            "the legs or the body do not fit there, driving or standing (the feasibility model the planner and the motion generator share)",
+        ),
+        CostValue::Infinite => Some(
+            "a wheel stands on or next to an untraversable height difference (infinite foot cost)",
+        ),
+        CostValue::Unknown => Some("the robot stands on unknown terrain or reaches off the map"),
+    }
+}
+
+/// The pose a replan starts from: `start` if the planner can start there, else the
+/// nearest lattice pose within `radius_m` and two orientation steps of it that it can (the
+/// nearest first, then the smaller turn), else `start` (whose planning then fails with
+/// [`PlanError::Untraversable`], [`Prepared::set_start`]). A robot that stopped
+/// mid-manoeuvre may stand with a wheel next to an edge, where no plan may start; the path
+/// follower takes it from where it stands to the new path's first pose.
+pub fn nearest_start(
+    prep: &Prepared,
+    robot: &RobotDescription,
+    start: Pose2,
+    radius_m: f64,
+) -> Pose2 {
+    let (params, maps, lattice) = (&prep.params, &prep.maps, &prep.lattice);
+    let Some(s) = lattice.state(&start) else {
+        return start;
+    };
+    if unfit(robot, params, maps, &lattice.pose(s)).is_none() {
+        return start;
+    }
+    let r = (radius_m / lattice.resolution).ceil() as i32;
+    let n = i32::from(lattice.orientations);
+    let mut candidates = Vec::new();
+    for di in -r..=r {
+        for dj in -r..=r {
+            let d = f64::from(di).hypot(f64::from(dj)) * lattice.resolution;
+            if d > radius_m {
+                continue;
+            }
+            for dt in [0_i32, 1, -1, 2, -2] {
+                candidates.push((d, dt.abs(), di, dj, dt));
+            }
+        }
+    }
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (_, _, di, dj, dt) in candidates {
+        let (i, j) = (i32::from(s.i) + di, i32::from(s.j) + dj);
+        let (Ok(i), Ok(j)) = (i16::try_from(i), i16::try_from(j)) else { continue };
+        if i < 0
+            || j < 0
+            || i32::from(i) >= i32::from(lattice.nx)
+            || i32::from(j) >= i32::from(lattice.ny)
+        {
+            continue;
+        }
+        let theta = (i32::from(s.theta) + dt).rem_euclid(n) as u8;
+        let pose = lattice.pose(LatticeState::new(i, j, theta));
+        if unfit(robot, params, maps, &pose).is_none() {
+            return pose;
+        }
+    }
+    start
+}
