@@ -320,6 +320,24 @@ pub const ZMP_SHIFT_M: f64 = 0.01;
 mod tests {
     use super::*;
 
+    #[test]
+    fn a_posture_on_three_feet_needs_the_lift_threshold() {
+        // The paper's 3 cm for every posture; on three feet the executor's lift threshold,
+        // 2 cm + 3 cm of sag reserve = 5 cm; a threshold below 3 cm does not lower it.
+        let o = MotionOptions::default();
+        let mut p = Posture {
+            base_position: [0.0, 0.0, 0.5],
+            base_rpy: [0.0; 3],
+            feet: [[0.0; 3]; 4],
+            contact: [true; 4],
+        };
+        assert!((o.required_margin(&p) - 0.03).abs() < 1e-12);
+        p.contact[2] = false;
+        assert!((o.required_margin(&p) - 0.05).abs() < 1e-12);
+        let low = MotionOptions { min_three_contact_margin_m: 0.01, ..o };
+        assert!((low.required_margin(&p) - 0.03).abs() < 1e-12);
+    }
+
     fn maps(f: impl Fn(f64, f64) -> f64) -> CostMaps {
         let hm = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |i, j| {
             f(-2.0 + (i as f64 + 0.5) * 0.025, -2.0 + (j as f64 + 0.5) * 0.025)

@@ -5,6 +5,7 @@
 mod common;
 
 use momaro::jobs::generate::{GenerateOptions, checked_case, run};
+use momaro::motion::manoeuvres::ALL;
 use momaro::planner::prepare;
 use momaro::robot::RobotDescription;
 use momaro::scenario::Scenario;
@@ -27,7 +28,7 @@ fn every_class_passes_prepare_for_many_seeds() {
         for f in &summary.files {
             let s = Scenario::load(&f.path).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(s.class.as_deref(), Some(class.name()));
-            prepare(&s, &robot, Default::default())
+            prepare(&s, &robot, Default::default(), &ALL)
                 .unwrap_or_else(|e| panic!("{}: {e}", f.path.display()));
         }
     }

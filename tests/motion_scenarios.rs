@@ -12,6 +12,7 @@ mod common;
 use common::{first_solution, probe_path};
 
 use momaro::feasibility::{MotionOptions, ZMP_SHIFT_M};
+use momaro::motion::manoeuvres::ALL;
 use momaro::motion::{DetailedPath, MotionError, Phase, expand_path};
 use momaro::path::ManoeuvreKind;
 use momaro::path::PathElement;
@@ -36,7 +37,7 @@ fn expand(
     path: &[PathElement],
 ) -> Result<DetailedPath, MotionError> {
     let robot = sim.robot().clone();
-    let prep = planner::prepare(s, &robot, Default::default()).expect("maps");
+    let prep = planner::prepare(s, &robot, Default::default(), &ALL).expect("maps");
     let options = MotionOptions::from_params(&prep.params);
     expand_path(path, &robot, &prep.maps, sim, &options)
 }
@@ -147,7 +148,7 @@ fn whole_path_checked(
 ) -> (Scenario, Simulation, PlanSummary, DetailedPath) {
     let s = scenario(name);
     let mut sim = sim();
-    let p = planner::run(&s, sim.robot(), opts).expect("plan");
+    let p = planner::run(&s, sim.robot(), opts, &ALL).expect("plan");
     let d = expand(&s, &mut sim, &p.path).expect("expansion");
     report(&s, p.path.len(), p.path.len(), &d);
     check(&d, &sim);
@@ -187,7 +188,7 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
     // The path up to its first step, with a margin no step can keep, fails at that step,
     // naming it and its leg.
     let robot = sim.robot().clone();
-    let prep = planner::prepare(&s, &robot, Default::default()).expect("maps");
+    let prep = planner::prepare(&s, &robot, Default::default(), &ALL).expect("maps");
     // 25 cm: the four-wheel postures before it keep more (about 0.3 m), no three-wheel
     // posture can: the support triangles the feet can form have inscribed circles of at
     // most about 0.24 m. (At 15 cm, since the swing clears only what the wheels pass, a
@@ -239,7 +240,7 @@ height = 0.1
     let s = Scenario::parse(text, Path::new("blocked_wheel.toml")).expect("scenario");
     let mut sim = sim();
     let robot = sim.robot().clone();
-    let prep = planner::prepare(&s, &robot, Default::default()).expect("maps");
+    let prep = planner::prepare(&s, &robot, Default::default(), &ALL).expect("maps");
     let neutral = robot.neutral_footprint();
     let start = PathElement {
         kind: ManoeuvreKind::Start,
@@ -309,7 +310,7 @@ fn expand_generated_up_and_over(dir: &str, seeds: &[u64], opts: &PlanOptions) {
     for &seed in seeds {
         let (case, _) = checked_case(Class::UpAndOver, seed, &dir, &robot).expect("generated");
         let s = case.scenario(&dir).expect("scenario");
-        let p = planner::run(&s, sim.robot(), opts).expect("plan");
+        let p = planner::run(&s, sim.robot(), opts, &ALL).expect("plan");
         assert!(p.steps >= 8, "{}: {} steps planned", s.name, p.steps);
         let d = expand(&s, &mut sim, &p.path).unwrap_or_else(|e| panic!("{}: {e}", s.name));
         report(&s, p.path.len(), p.path.len(), &d);

@@ -7,6 +7,7 @@
 //! first solution or its probe's path. No outcome depends on the machine's speed.
 
 use momaro::geometry::Pose2;
+use momaro::motion::manoeuvres::ALL;
 use momaro::params::{FootModel, StepModel};
 use momaro::path::ManoeuvreKind;
 use momaro::path::PathElement;
@@ -37,7 +38,7 @@ fn scenario(name: &str) -> Scenario {
 }
 
 fn plan(s: &Scenario, opts: &PlanOptions) -> PlanSummary {
-    match run(s, &robot(), opts) {
+    match run(s, &robot(), opts, &ALL) {
         Ok(p) => p,
         Err(e) => panic!("{}: {e}", s.name),
     }
@@ -226,7 +227,7 @@ fn flights_longer_than_the_robot_need_the_stairs_step_model() {
     s.params.step_model = StepModel::Paper;
     s.map.x_max = 2.7; // a smaller map, the goal on the landing: the search ends sooner
     s.goal.x = 2.0;
-    match run(&s, &robot(), &first_solution()) {
+    match run(&s, &robot(), &first_solution(), &ALL) {
         Err(PlanError::NoPath { .. }) => {}
         other => panic!("expected no path with the paper's step model: {other:?}"),
     }
@@ -333,7 +334,7 @@ fn plans_on_one_prepared_world_share_its_heuristic_and_find_the_same_path() {
     let robot = robot();
     let opts = first_solution();
     let alone = plan(&s, &opts);
-    let prep = planner::prepare_for(&s, &robot, &opts).expect("maps");
+    let prep = planner::prepare_for(&s, &robot, &opts, &ALL).expect("maps");
     let first = planner::run_on(&prep, &s, &robot, &opts).expect("plan");
     let again = planner::run_on(&prep, &s, &robot, &opts).expect("plan");
     assert!(!alone.heuristic.reused && !first.heuristic.reused);
@@ -386,14 +387,15 @@ fn a_replan_starts_from_the_nearest_pose_a_plan_can_start_from() {
     ));
     let robot = robot();
     assert!(matches!(
-        planner::prepare(&walled, &robot, Default::default()),
+        planner::prepare(&walled, &robot, Default::default(), &ALL),
         Err(PlanError::Untraversable { .. })
     ));
     // The run's world is prepared from a start clear of the wall; the robot then stops
     // at the scenario's start, next to it.
     let mut clear = walled.clone();
     clear.start = Pose2::new(walled.start.x, walled.start.y - 0.3, walled.start.theta);
-    let mut prep = planner::prepare(&clear, &robot, Default::default()).expect("clear of the wall");
+    let mut prep =
+        planner::prepare(&clear, &robot, Default::default(), &ALL).expect("clear of the wall");
     assert!(matches!(
         prep.set_start(&walled, &robot, walled.start),
         Err(PlanError::Untraversable { which: "start", .. })
@@ -415,14 +417,14 @@ fn bad_poses_and_unreachable_goals_are_clear_errors_within_the_time_limit() {
     let walled = format!(
         "{base}\n[[terrain]]\nkind = \"box\"\ncenter = [0.0, 0.5]\nsize = [2.0, 0.1]\nheight = 0.5\n"
     );
-    match run(&parse(&walled), &robot(), &arastar(10.0)) {
+    match run(&parse(&walled), &robot(), &arastar(10.0), &ALL) {
         Err(PlanError::Untraversable { which, .. }) => assert_eq!(which, "start"),
         other => panic!("{other:?}"),
     }
     // Start at the map's edge: the wheels reach off the map (unknown).
     let edge = base.clone().replacen("x = 0.0\ny = 0.0", "x = -2.95\ny = 0.0", 1);
     assert!(matches!(
-        run(&parse(&edge), &robot(), &arastar(10.0)),
+        run(&parse(&edge), &robot(), &arastar(10.0), &ALL),
         Err(PlanError::Untraversable { .. })
     ));
     // Goal boxed in by 0.4 m walls (too high to step over from outside): no path, and
@@ -453,7 +455,7 @@ height = 0.4
 "
     );
     let t0 = Instant::now();
-    let r = run(&parse(&boxed), &robot(), &arastar(5.0));
+    let r = run(&parse(&boxed), &robot(), &arastar(5.0), &ALL);
     assert!(t0.elapsed().as_secs_f64() < 7.0, "time limit overrun");
     match r {
         Err(PlanError::NoPath { .. }) => {}
@@ -461,14 +463,17 @@ height = 0.4
     }
     // A tiny time limit holds on the platform.
     let t0 = Instant::now();
-    let r = run(&scenario("platform"), &robot(), &arastar(0.05));
+    let r = run(&scenario("platform"), &robot(), &arastar(0.05), &ALL);
     assert!(t0.elapsed().as_secs_f64() < 1.0, "time limit overrun");
     if let Err(e) = r {
         assert!(matches!(e, PlanError::NoPath { .. }), "{e}");
     }
     // Invalid options.
     let bad = PlanOptions { time_limit_s: f64::NAN, ..PlanOptions::default() };
-    assert!(matches!(run(&scenario("flat"), &robot(), &bad), Err(PlanError::BadOption { .. })));
+    assert!(matches!(
+        run(&scenario("flat"), &robot(), &bad, &ALL),
+        Err(PlanError::BadOption { .. })
+    ));
 }
 
 /// ARA*'s probe (issue 15): on a generated up-and-over course (`generate --class
@@ -487,7 +492,7 @@ fn the_probe_answers_where_the_schedule_runs_out() {
     };
     let paper =
         PlanOptions { probe_epsilon: Some(3.0), max_expansions: Some(100_000), ..capped.clone() };
-    assert_stopped_by_expansion_limit(&run(&s, &robot(), &paper), "the paper's ARA*");
+    assert_stopped_by_expansion_limit(&run(&s, &robot(), &paper, &ALL), "the paper's ARA*");
     let p = plan(&s, &capped);
     assert_eq!(p.termination, "expansion_limit");
     assert_eq!(p.solutions.len(), 1);
@@ -511,7 +516,10 @@ fn a_guided_probe_climbs_open_sided_stairs_its_heuristic_alone_floods_beside() {
         let s = common::generated(momaro::scenario::generate::Class::Stairs, seed);
         let probe_only = PlanOptions { max_expansions: Some(50_000), ..probe_path() };
         let unguided = PlanOptions { probe_guidance: false, ..probe_only.clone() };
-        assert_stopped_by_expansion_limit(&run(&s, &robot(), &unguided), &format!("seed {seed}"));
+        assert_stopped_by_expansion_limit(
+            &run(&s, &robot(), &unguided, &ALL),
+            &format!("seed {seed}"),
+        );
         let p = plan(&s, &probe_only);
         let probe = &p.solutions[0];
         assert_eq!(probe.epsilon, 50.0, "seed {seed}");

@@ -17,6 +17,7 @@ use common::{first_solution, probe_path};
 use momaro::control::step_executor::{ExecEventKind, ExecFailure};
 use momaro::jobs::envelope::{self, Direction};
 use momaro::jobs::run::{self, Mission, Push, PushWhen, RunOptions, RunSummary};
+use momaro::motion::manoeuvres::ALL;
 use momaro::motion::{DetailedPath, Phase};
 use momaro::path::ManoeuvreKind;
 use momaro::planner::{self, PlanOptions, PlanSummary};
@@ -83,7 +84,7 @@ fn execute_prefix(sc: &Scenario, end: End, push: Option<Push>) -> RunSummary {
     let wall = Instant::now();
     let mut sim = Simulation::new(sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
-    let mut prep = planner::prepare_for(sc, &robot, &first_solution()).expect("maps");
+    let mut prep = planner::prepare_for(sc, &robot, &first_solution(), &ALL).expect("maps");
     let plan = planner::run_on(&prep, sc, &robot, &first_solution()).expect("plan");
     let mut end = prefix_end(&plan, end);
     assert!(end < plan.path.len(), "the prefix ends before the goal");
@@ -165,8 +166,10 @@ fn lateral_push_on_three_legs_puts_the_foot_down_without_tipping() {
     // 300 N: 150 N left a 20 cm margin at 19 cm; 400 N kept wheels off for 1.9 s and the
     // step was aborted (measured with an earlier plan).
     let robot = Simulation::robot_only(&common::model()).expect("model").robot().clone();
-    let step =
-        first_step_up(&planner::run(&sc, &robot, &first_solution()).expect("plan"), Leg::FrontLeft);
+    let step = first_step_up(
+        &planner::run(&sc, &robot, &first_solution(), &ALL).expect("plan"),
+        Leg::FrontLeft,
+    );
     let push = Push {
         when: PushWhen::Step { step, phase: Phase::Swing, delay_s: 1.0 },
         force: [0.0, 300.0, 0.0],
@@ -449,12 +452,12 @@ fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) 
     let wall = Instant::now();
     let mut sim = Simulation::new(&sc, &common::model()).expect("world compiles");
     let robot = sim.robot().clone();
-    let plan = planner::run(&planned, &robot, &opts.plan).expect("plan");
+    let plan = planner::run(&planned, &robot, &opts.plan, &ALL).expect("plan");
     let detailed =
         run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
     momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
     // Replans (if any) plan with the executor's parameters.
-    let mut prep = planner::prepare_for(&sc, &robot, &first_solution()).expect("maps");
+    let mut prep = planner::prepare_for(&sc, &robot, &first_solution(), &ALL).expect("maps");
     let mission = Mission { plan, detailed };
     let s = run::execute(&sc, &mut prep, &mut sim, mission, &opts, wall).expect("runs");
     (s, sim)

@@ -191,7 +191,7 @@ pub fn probe_bench(
         let (mut outcome, mut expansions, mut cost) = ("path", None, None);
         for _ in 0..opts.repeats {
             let t = Instant::now();
-            let result = planner::run(sc, robot, &plan_opts);
+            let result = planner::run(sc, robot, &plan_opts, &crate::motion::manoeuvres::ALL);
             times.push(t.elapsed().as_secs_f64());
             if let Ok(s) = &result {
                 searches.push(s.planning_time_s);
@@ -373,7 +373,12 @@ pub fn bench(
         return Err(bad("repeats", "0 must be at least 1"));
     }
     let file = || scenario.path.clone();
-    let prep = prepare(scenario, robot, ParamOverrides { k12: opts.k12, ..Default::default() })?;
+    let prep = prepare(
+        scenario,
+        robot,
+        ParamOverrides { k12: opts.k12, ..Default::default() },
+        &crate::motion::manoeuvres::ALL,
+    )?;
     let k12 = prep.params.k12;
     // `tables`: the heuristic cache the graph shares (none: tables of its own), and
     // whether the search stops at its first path.

@@ -48,7 +48,7 @@ pub fn run(
     expansion_image: Option<&std::path::Path>,
 ) -> Result<DetailedSummary, DetailedJobError> {
     let robot = sim.robot().clone();
-    let prep = planner::prepare_for(scenario, &robot, opts)?;
+    let prep = planner::prepare_for(scenario, &robot, opts, &crate::motion::manoeuvres::ALL)?;
     let mut counts = None;
     let plan = planner::plan::run_on_counted(
         &prep,
@@ -86,7 +86,12 @@ pub fn expand_prefix(
     plan: &PlanSummary,
     end: usize,
 ) -> Result<DetailedPath, DetailedJobError> {
-    let prep = planner::prepare(scenario, sim.robot(), planner::ParamOverrides::of_plan(plan))?;
+    let prep = planner::prepare(
+        scenario,
+        sim.robot(),
+        planner::ParamOverrides::of_plan(plan),
+        &crate::motion::manoeuvres::ALL,
+    )?;
     expand_prefix_on(&prep, scenario, sim, plan, end)
 }
 

@@ -129,7 +129,12 @@ pub fn checked_case(
         let path = dir.join(case.file_name());
         match Scenario::parse(&text, &path) {
             Ok(scenario) => {
-                match planner::prepare(&scenario, robot, planner::ParamOverrides::default()) {
+                match planner::prepare(
+                    &scenario,
+                    robot,
+                    planner::ParamOverrides::default(),
+                    &crate::motion::manoeuvres::ALL,
+                ) {
                     Ok(_) => return Ok((case, text)),
                     Err(e) => reason = format!("draw {}: {e}", case.draw),
                 }

@@ -32,7 +32,13 @@ pub fn run(
     expansion_image: Option<&Path>,
 ) -> Result<PlanSummary, PlanJobError> {
     let mut counts = None;
-    let result = run_counted(scenario, robot, opts, expansion_image.map(|_| &mut counts));
+    let result = run_counted(
+        scenario,
+        robot,
+        opts,
+        &crate::motion::manoeuvres::ALL,
+        expansion_image.map(|_| &mut counts),
+    );
     write_counts(expansion_image, counts.as_ref())?;
     Ok(result?)
 }

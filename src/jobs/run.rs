@@ -554,7 +554,8 @@ pub fn run(scenario: &Scenario, opts: &RunOptions) -> Result<RunSummary, RunJobE
     let mut sim = Simulation::new(scenario, &opts.model_path)?;
     // One world for the run: every plan (retries, replans), the generator and the
     // recording use its maps, and the plans share its heuristic toward the goal.
-    let mut prep = planner::prepare_for(scenario, sim.robot(), &opts.plan)?;
+    let mut prep =
+        planner::prepare_for(scenario, sim.robot(), &opts.plan, &crate::motion::manoeuvres::ALL)?;
     let mission = match plan_mission(&prep, scenario, &mut sim, &opts.plan) {
         Ok(m) => m,
         Err(e) => return unexecuted(scenario, e, wall),

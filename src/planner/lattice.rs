@@ -24,16 +24,17 @@ pub struct LatticeState {
     pub theta: u8,
     /// Footprint id ([`NEUTRAL_FOOTPRINT`] for driving).
     pub footprint: u16,
-    /// 0 for a pose. `k + 1` for the intermediate node of a lazily checked step of leg
-    /// `k` from this pose (`hybrid` module docs, "Lazy step checks"): the search reaches
-    /// it at the step's least possible cost and checks the step only if it expands it.
-    pub step_pending: u8,
+    /// 0 for a pose; otherwise the intermediate node of a lazily checked edge from this
+    /// pose, tagged by the manoeuvre that offered it (`graph` module docs, "Lazy edges"):
+    /// the search reaches it at the edge's least possible cost, and the manoeuvre checks
+    /// the edge only if the search expands it. Steps tag leg `k`'s as `k + 1`.
+    pub pending: u8,
 }
 
 impl LatticeState {
     /// A neutral-footprint state.
     pub const fn new(i: i16, j: i16, theta: u8) -> Self {
-        Self { i, j, theta, footprint: NEUTRAL_FOOTPRINT, step_pending: 0 }
+        Self { i, j, theta, footprint: NEUTRAL_FOOTPRINT, pending: 0 }
     }
 }
 

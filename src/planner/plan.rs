@@ -15,6 +15,7 @@
 //! planner" (Sec. VIII): every edge re-evaluated with k12 = 1, so variants with different
 //! k12 compare.
 
+use super::graph::ManoeuvreSet;
 use super::options::{ParamOverrides, PlanError, PlanOptions, bad, check_options};
 use super::world::{MapInfo, Prepared, params_for, prepare_for};
 use super::{HybridGraph, LatticeState, ManoeuvreStats, Neighbourhood, PoseKey};
@@ -197,7 +198,7 @@ fn plain_edge_costs(
         .collect()
 }
 
-/// Plans a path for `scenario` (see the module docs).
+/// Plans a path for `scenario` with `manoeuvres` (see the module docs).
 ///
 /// # Errors
 /// [`PlanError`]: bad options, an unbuildable map, a start or goal off the map or on
@@ -206,8 +207,9 @@ pub fn run(
     scenario: &Scenario,
     robot: &RobotDescription,
     opts: &PlanOptions,
+    manoeuvres: &'static dyn ManoeuvreSet,
 ) -> Result<PlanSummary, PlanError> {
-    run_counted(scenario, robot, opts, None)
+    run_counted(scenario, robot, opts, manoeuvres, None)
 }
 
 /// Where a search went: expansions per base cell (row-major over the height map's cells,
@@ -230,11 +232,12 @@ pub fn run_counted(
     scenario: &Scenario,
     robot: &RobotDescription,
     opts: &PlanOptions,
+    manoeuvres: &'static dyn ManoeuvreSet,
     counts: Option<&mut Option<ExpansionCounts>>,
 ) -> Result<PlanSummary, PlanError> {
     let limit = check_options(opts)?;
     let t0 = Instant::now();
-    let prep = prepare_for(scenario, robot, opts)?;
+    let prep = prepare_for(scenario, robot, opts, manoeuvres)?;
     search_prepared(&prep, scenario, robot, opts, (t0, limit), counts)
 }
 

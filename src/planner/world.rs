@@ -5,6 +5,7 @@
 //! the generator's retries, the replans from where the robot stopped) share one
 //! [`Prepared`] world.
 
+use super::graph::ManoeuvreSet;
 use super::options::{ParamOverrides, PlanError, PlanOptions};
 use super::{
     DrivingGoal, HeuristicCache, HybridConfig, HybridGraph, Lattice, LatticeError, LatticeState,
@@ -49,8 +50,10 @@ pub struct Prepared {
     pub goal: LatticeState,
     /// Time spent building, s.
     pub setup_time_s: f64,
-    /// The heuristic tables of the searches on these maps ([`run_on`]'s graphs).
+    /// The heuristic tables of the searches on these maps ([`super::run_on`]'s graphs).
     pub heuristics: HeuristicCache,
+    /// The manoeuvres the robot plans with (`motion::manoeuvres::ALL`).
+    pub manoeuvres: &'static dyn ManoeuvreSet,
 }
 
 impl Prepared {
@@ -88,6 +91,7 @@ impl Prepared {
             self.params.orientations,
             config,
             DrivingGoal::at(self.goal),
+            self.manoeuvres,
         )
     }
 
@@ -105,7 +109,8 @@ impl Prepared {
     }
 }
 
-/// Builds the height map and cost maps of `scenario` and checks its start and goal.
+/// Builds the height map and cost maps of `scenario` and checks its start and goal; the
+/// robot plans on it with `manoeuvres`.
 ///
 /// # Errors
 /// Invalid parameters, an unbuildable map, or a start / goal off the map or on
@@ -114,6 +119,7 @@ pub fn prepare(
     scenario: &Scenario,
     robot: &RobotDescription,
     overrides: ParamOverrides,
+    manoeuvres: &'static dyn ManoeuvreSet,
 ) -> Result<Prepared, PlanError> {
     let t0 = Instant::now();
     let params = params_for(scenario, overrides)?;
@@ -129,6 +135,7 @@ pub fn prepare(
         lattice,
         setup_time_s: t0.elapsed().as_secs_f64(),
         heuristics: HeuristicCache::default(),
+        manoeuvres,
     })
 }
 
@@ -140,8 +147,9 @@ pub fn prepare_for(
     scenario: &Scenario,
     robot: &RobotDescription,
     opts: &PlanOptions,
+    manoeuvres: &'static dyn ManoeuvreSet,
 ) -> Result<Prepared, PlanError> {
-    prepare(scenario, robot, opts.overrides)
+    prepare(scenario, robot, opts.overrides, manoeuvres)
 }
 
 /// The lattice state of `scenario`'s `which` pose `pose`, checked: on the map, and one

@@ -60,9 +60,9 @@
 //! counts as reachable), and a cell that is not admissible itself (only ever a start
 //! the robot was put in) counts as reachable: the search from it goes on as before.
 
-use super::heuristic::StepBound;
-use super::lattice::Lattice;
+use super::step_bound::StepBound;
 use crate::cost::{CostMaps, DiscMaxLayer};
+use crate::planner::lattice::Lattice;
 use crate::robot::RobotDescription;
 use crate::terrain::{HeightMap, square_window_max};
 use std::f64::consts::FRAC_PI_2;

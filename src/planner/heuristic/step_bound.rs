@@ -1,5 +1,5 @@
 //! A lower bound on the step costs still needed to reach the goal: the informed part of
-//! the hybrid graph's heuristic ([`super::HybridGraph`]), computed once per plan.
+//! the hybrid graph's heuristic ([`crate::planner::HybridGraph`]), computed once per plan.
 //!
 //! **Idea.** Every foot stands on a cell of finite foot cost C_F (eq. 1) in every state
 //! of the hybrid graph, and the only manoeuvre that carries a foot across untraversable

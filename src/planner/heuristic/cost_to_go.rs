@@ -1,5 +1,5 @@
 //! The base-pose cost-to-go: the hybrid heuristic's informed lower bound on the driving,
-//! turning and base-shift costs still to come ([`super::HybridGraph`], issue 15). A
+//! turning and base-shift costs still to come ([`crate::planner::HybridGraph`], issue 15). A
 //! backward Dijkstra from the goal over (cell, orientation) nodes of the lattice — the
 //! nodes `reachability` floods, with costs — in which every edge weighs at most what the
 //! manoeuvre of the hybrid graph it stands for costs, whatever the footprint: an exact
@@ -77,9 +77,9 @@
 //! answers `min(D, MAX_DIST)` instead, consistent like a deadline's frozen bound
 //! ([`CostToGo::set_deadline`]).
 
-use super::driving::DrivingConfig;
-use super::lattice::{Lattice, LatticeState};
 use crate::cost::{CostMaps, DrivingStencil};
+use crate::planner::driving::DrivingConfig;
+use crate::planner::lattice::{Lattice, LatticeState};
 use crate::search::Cost;
 use std::cell::{Cell, RefCell};
 use std::time::Instant;
