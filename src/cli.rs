@@ -113,7 +113,7 @@ pub enum Command {
         planner: PlannerArgs,
         /// Noise on the measured base pose: position std (m), yaw std (degrees), seed.
         #[arg(long, value_name = "POS_M,YAW_DEG,SEED", value_parser = parse_noise)]
-        noise: Option<jobs::run::PoseNoise>,
+        noise: Option<crate::closed_loop::PoseNoise>,
         /// Write a Rerun recording.
         #[arg(long, value_name = "FILE.rrd")]
         rerun: Option<PathBuf>,
@@ -422,7 +422,7 @@ fn class_parser() -> impl clap::builder::TypedValueParser<Value = Class> {
     clap::builder::PossibleValuesParser::new(Class::NAMES).try_map(|s| s.parse::<Class>())
 }
 
-fn parse_noise(s: &str) -> Result<jobs::run::PoseNoise, String> {
+fn parse_noise(s: &str) -> Result<crate::closed_loop::PoseNoise, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
         return Err(format!("expected POS_M,YAW_DEG,SEED, got `{s}`"));
@@ -433,7 +433,7 @@ fn parse_noise(s: &str) -> Result<jobs::run::PoseNoise, String> {
             .filter(|v| v.is_finite() && *v >= 0.0)
             .ok_or_else(|| format!("`{p}` is not a finite number >= 0"))
     };
-    Ok(jobs::run::PoseNoise {
+    Ok(crate::closed_loop::PoseNoise {
         position_std_m: num(parts[0])?,
         yaw_std_rad: num(parts[1])?.to_radians(),
         seed: parts[2].parse().map_err(|e| format!("seed `{}`: {e}", parts[2]))?,
@@ -470,9 +470,9 @@ fn plan_error(e: crate::planner::PlanError) -> anyhow::Error {
     }
 }
 
-fn run_error(e: jobs::run::RunJobError) -> anyhow::Error {
+fn run_error(e: crate::closed_loop::RunError) -> anyhow::Error {
     match e {
-        jobs::run::RunJobError::Plan(p) => plan_error(p),
+        crate::closed_loop::RunError::Plan(p) => plan_error(p),
         other => anyhow::Error::new(other),
     }
 }
@@ -570,7 +570,7 @@ fn check(
     let jobs = workers_or_all(jobs);
     let files = suite_files(paths)?;
     let opts = check::CheckOptions {
-        run: jobs::run::RunOptions::new(planner.options(), model),
+        run: crate::closed_loop::RunOptions::new(planner.options(), model),
         jobs,
         shard,
     };
@@ -940,11 +940,11 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
             Ok(true)
         }
         Command::Run { scenario, planner, noise, rerun, json, model } => {
-            let opts = jobs::run::RunOptions {
+            let opts = crate::closed_loop::RunOptions {
                 rerun,
                 progress: !json,
                 noise,
-                ..jobs::run::RunOptions::new(planner.options(), model.model)
+                ..crate::closed_loop::RunOptions::new(planner.options(), model.model)
             };
             let s = match load(&scenario)
                 .and_then(|sc| jobs::run::run(&sc, &opts).map_err(run_error))
@@ -1044,7 +1044,7 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
                 directions,
                 out_dir: out,
                 check: jobs::check::CheckOptions {
-                    run: jobs::run::RunOptions::new(plan, model.model),
+                    run: crate::closed_loop::RunOptions::new(plan, model.model),
                     jobs: workers,
                     shard: None,
                 },

@@ -3,6 +3,7 @@
 //! (IROS 2017). See ARCHITECTURE.md for how the modules fit together.
 
 pub mod cli;
+pub mod closed_loop;
 pub mod control;
 pub mod cost;
 pub mod feasibility;

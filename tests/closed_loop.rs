@@ -3,7 +3,7 @@
 
 mod common;
 
-use momaro::jobs::run::{PoseNoise, RunOptions, RunSummary, run};
+use momaro::closed_loop::{PoseNoise, RunOptions, RunSummary, run};
 use momaro::planner::PlanOptions;
 
 fn run_scenario(name: &str, noise: Option<PoseNoise>) -> RunSummary {
@@ -125,4 +125,46 @@ fn drives_generated_clutter_on_all_wheels(seed: u64) {
     assert!(s.passed, "{s:#?}");
     assert!(s.min_stability_margin_m >= 0.02, "{s:#?}");
     assert_eq!(s.static_violation_s, 0.0, "{:?}", s.events);
+}
+
+/// The loop as a library: a program sets up the world, plans the mission, stands the
+/// robot at the start and drives [`ClosedLoop`] one control tick at a time, looking at
+/// the simulation between ticks; the summary is the one `run` gives (runs are
+/// deterministic), and each tick advances the simulation by one control period.
+#[test]
+fn the_loop_driven_tick_by_tick_from_the_library_is_the_run() {
+    use momaro::closed_loop::{ClosedLoop, Tick, plan_mission, stand_at_start};
+    use momaro::motion::manoeuvres::ALL;
+    use momaro::sim::Simulation;
+    let sc = common::scenario("flat");
+    let opts = RunOptions::new(common::first_solution(), common::model());
+    let whole = run(&sc, &opts).expect("run completes");
+
+    let wall = std::time::Instant::now();
+    let mut sim = Simulation::new(&sc, &opts.model_path).expect("world compiles");
+    let mut prep = momaro::planner::prepare_for(&sc, sim.robot(), &opts.plan, &ALL).expect("world");
+    let mission = plan_mission(&prep, &sc, &mut sim, &opts.plan).expect("a mission");
+    stand_at_start(&mut sim, &sc).expect("stands");
+    let mut lp = ClosedLoop::start(&sc, &mut prep, &mut sim, mission, &opts, wall).expect("starts");
+    let (mut ticks, mut last) = (0usize, lp.sim().time());
+    let period = 0.01;
+    while lp.step().expect("tick") == Tick::Running {
+        let now = lp.sim().time();
+        assert!((now - last - period).abs() < 1e-9, "tick {ticks}: {last} -> {now}");
+        (ticks, last) = (ticks + 1, now);
+    }
+    assert_eq!(lp.step().expect("ended"), Tick::Ended, "an ended loop stays ended");
+    assert_eq!(lp.replans(), 0);
+    let stepped = lp.finish().expect("summary");
+    assert!(ticks > 100, "{ticks} ticks");
+    assert!((stepped.sim_time_s - ticks as f64 * period).abs() < 1e-6, "{}", stepped.sim_time_s);
+    for (a, b) in [
+        (whole.goal_position_error_m, stepped.goal_position_error_m),
+        (whole.min_stability_margin_m, stepped.min_stability_margin_m),
+        (whole.sim_time_s, stepped.sim_time_s),
+        (whole.max_tracking_error_m, stepped.max_tracking_error_m),
+    ] {
+        assert_eq!(a.to_bits(), b.to_bits(), "{a} vs {b}");
+    }
+    assert_eq!((whole.passed, whole.plan_cost), (stepped.passed, stepped.plan_cost));
 }

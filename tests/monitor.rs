@@ -3,8 +3,8 @@
 
 mod common;
 
-use momaro::jobs::run::{RunOptions, run};
-use momaro::jobs::stand_at_start;
+use momaro::closed_loop::stand_at_start;
+use momaro::closed_loop::{RunOptions, run};
 use momaro::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor, TipCause};
 use momaro::planner::PlanOptions;
 use momaro::robot::Leg;
@@ -65,7 +65,7 @@ fn a_closed_room_is_no_path_at_once() {
     let sc = common::scenario("closed_room");
     let plan = PlanOptions { final_epsilon: Some(3.0), time_limit_s: 30.0, ..Default::default() };
     let s = run(&sc, &RunOptions::new(plan, common::model())).expect("runs");
-    assert_eq!(s.failure_kind, Some(momaro::jobs::run::FailureKind::NoPath), "{:?}", s.failure);
+    assert_eq!(s.failure_kind, Some(momaro::closed_loop::FailureKind::NoPath), "{:?}", s.failure);
     assert!(s.passed, "{:?}", s.expectations);
     assert_eq!(s.sim_time_s, 0.0);
 }

@@ -14,9 +14,9 @@ mod common;
 
 use common::{first_solution, probe_path};
 
+use momaro::closed_loop::{self as run, Mission, Push, PushWhen, RunOptions, RunSummary};
 use momaro::control::step_executor::{ExecEventKind, ExecFailure};
 use momaro::jobs::envelope::{self, Direction};
-use momaro::jobs::run::{self, Mission, Push, PushWhen, RunOptions, RunSummary};
 use momaro::motion::manoeuvres::ALL;
 use momaro::motion::{DetailedPath, Phase};
 use momaro::path::ManoeuvreKind;
@@ -96,7 +96,7 @@ fn execute_prefix(sc: &Scenario, end: End, push: Option<Push>) -> RunSummary {
         end -= 1;
     }
     let detailed = prefix_keyframes(sc, &mut sim, &plan, end);
-    momaro::jobs::stand_at_start(&mut sim, sc).expect("stands");
+    momaro::closed_loop::stand_at_start(&mut sim, sc).expect("stands");
     let opts =
         RunOptions { max_replans: 0, push, ..RunOptions::new(first_solution(), common::model()) };
     let mission = Mission { plan, detailed };
@@ -455,7 +455,7 @@ fn execute_unliftable(name: &str, opts: RunOptions) -> (RunSummary, Simulation) 
     let plan = planner::run(&planned, &robot, &opts.plan, &ALL).expect("plan");
     let detailed =
         run::expand_mission(&planned, &mut sim, &plan, plan.path.len()).expect("the plan expands");
-    momaro::jobs::stand_at_start(&mut sim, &sc).expect("stands");
+    momaro::closed_loop::stand_at_start(&mut sim, &sc).expect("stands");
     // Replans (if any) plan with the executor's parameters.
     let mut prep = planner::prepare_for(&sc, &robot, &first_solution(), &ALL).expect("maps");
     let mission = Mission { plan, detailed };

@@ -85,7 +85,7 @@ pub fn sim_bench(
     let mut steps = 0;
     for _ in 0..repeats {
         let mut sim = Simulation::new(scenario, &opts.model_path)?;
-        super::stand_at_start(&mut sim, scenario)?;
+        crate::closed_loop::stand_at_start(&mut sim, scenario)?;
         steps = (opts.duration_s / sim.timestep()).round() as usize;
         let t = Instant::now();
         sim.step(steps)?;

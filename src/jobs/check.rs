@@ -24,7 +24,8 @@
 //! of a run (or a panic) is a [`Verdict::Error`] row with the error chain. The rest of the
 //! suite runs either way.
 
-use super::run::{self, FailureKind, RunJobError, RunOptions, RunSummary};
+use super::run;
+use crate::closed_loop::{FailureKind, RunError, RunOptions, RunSummary};
 use crate::planner::PlanError;
 use crate::scenario::Scenario;
 use serde::{Serialize, Serializer};
@@ -500,10 +501,10 @@ fn chain(e: &dyn std::error::Error) -> String {
 }
 
 /// Whether a run error is the input's fault (what `momaro run` exits 2 for).
-fn is_input_error(e: &RunJobError) -> bool {
+fn is_input_error(e: &RunError) -> bool {
     matches!(
         e,
-        RunJobError::Plan(
+        RunError::Plan(
             PlanError::BadOption { .. }
                 | PlanError::Params { .. }
                 | PlanError::OffMap { .. }
@@ -872,7 +873,7 @@ mod tests {
     #[test]
     fn an_impossible_course_that_gets_a_plan_is_unsafe_and_an_unreached_goal_is_not() {
         let mut planned = summary(false, true, None, false, 0.0);
-        planned.expectations.push(crate::jobs::run::ExpectationResult {
+        planned.expectations.push(crate::closed_loop::ExpectationResult {
             name: "outcome",
             passed: false,
             detail: "a plan".into(),

@@ -10,7 +10,7 @@ use crate::render::{self, ImageError, RgbImage};
 use crate::scenario::Scenario;
 use crate::sim::{SimError, Simulation};
 use crate::terrain::sensed::{SensedAgreement, agreement};
-use crate::terrain::{HeightMap, LaserScanner, RasteriseError, SensedError, rasterise};
+use crate::terrain::{HeightMap, LaserScanner, RasteriseError, SensedError, scenario_map};
 use crate::viz::{Recorder, VizError};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -112,25 +112,12 @@ pub struct CostmapSummary {
     pub images: Vec<PathBuf>,
 }
 
-/// Grid of a scenario's height map: origin, cells along x and y. Covers the map extent plus
-/// a margin of r_N.
-pub fn map_grid(scenario: &Scenario) -> ([f64; 2], [usize; 2]) {
-    let p = &scenario.params;
-    let margin = p.r_n_m;
-    let m = &scenario.map;
-    let origin = [m.x_min - margin, m.y_min - margin];
-    let cells = |span: f64| ((span + 2.0 * margin) / p.grid_resolution_m).ceil().max(1.0) as usize;
-    (origin, [cells(m.x_max - m.x_min), cells(m.y_max - m.y_min)])
-}
-
 /// The scenario's rasterised height map.
 ///
 /// # Errors
 /// [`CostmapError::Rasterise`].
 pub fn rasterised_map(scenario: &Scenario) -> Result<HeightMap, CostmapError> {
-    let (origin, [nx, ny]) = map_grid(scenario);
-    let res = scenario.params.grid_resolution_m;
-    rasterise(&scenario.terrain, origin, [nx as f64 * res, ny as f64 * res], res)
+    scenario_map(scenario)
         .map_err(|source| CostmapError::Rasterise { scenario: scenario.name.clone(), source })
 }
 
@@ -144,7 +131,7 @@ pub fn sensed_map(
     raster: &HeightMap,
 ) -> Result<(HeightMap, SensedSummary), CostmapError> {
     let mut sim = Simulation::new(scenario, model_path)?;
-    super::stand_at_start(&mut sim, scenario)?;
+    crate::closed_loop::stand_at_start(&mut sim, scenario)?;
     let laser_origin = sim.site_position("laser")?;
     let scanner = LaserScanner::at(laser_origin);
     let (nx, ny) = raster.dims();

@@ -1,8 +1,8 @@
 //! `momaro plan --detailed`: plan, then expand the abstract path into stable keyframes
 //! (step motion generation, Sec. VI) with MuJoCo's CoM.
 
-use crate::feasibility::MotionOptions;
-use crate::motion::{DetailedPath, MotionError, expand_path};
+use crate::closed_loop::mission::expand_mission_on;
+use crate::motion::{DetailedPath, MotionError};
 use crate::planner::{self, PlanError, PlanOptions, PlanSummary};
 use crate::scenario::Scenario;
 use crate::sim::Simulation;
@@ -59,58 +59,9 @@ pub fn run(
     );
     super::plan::write_counts(expansion_image, counts.as_ref())?;
     let plan = plan?;
-    let detailed = expand_prefix_on(&prep, scenario, sim, &plan, plan.path.len())?;
+    let detailed = expand_mission_on(&prep, sim, &plan, plan.path.len())
+        .map_err(|source| DetailedJobError::Motion { scenario: scenario.name.clone(), source })?;
     Ok(DetailedSummary { plan, detailed })
-}
-
-/// Expands an existing plan of `scenario`.
-///
-/// # Errors
-/// [`DetailedJobError`] if the maps cannot be built or the expansion fails.
-pub fn expand(
-    scenario: &Scenario,
-    sim: &mut Simulation,
-    plan: &PlanSummary,
-) -> Result<DetailedPath, DetailedJobError> {
-    expand_prefix(scenario, sim, plan, plan.path.len())
-}
-
-/// Expands the first `end` elements of `plan`'s path (the whole path for its length), on
-/// the maps the plan was made on (its k12, step cost factor and models).
-///
-/// # Errors
-/// [`DetailedJobError`] if the maps cannot be built or the expansion fails.
-pub fn expand_prefix(
-    scenario: &Scenario,
-    sim: &mut Simulation,
-    plan: &PlanSummary,
-    end: usize,
-) -> Result<DetailedPath, DetailedJobError> {
-    let prep = planner::prepare(
-        scenario,
-        sim.robot(),
-        planner::ParamOverrides::of_plan(plan),
-        &crate::motion::manoeuvres::ALL,
-    )?;
-    expand_prefix_on(&prep, scenario, sim, plan, end)
-}
-
-/// [`expand_prefix`] on the world `prep` the plan was made on (`planner::run_on`).
-///
-/// # Errors
-/// [`DetailedJobError::Motion`] if the expansion fails.
-pub fn expand_prefix_on(
-    prep: &planner::Prepared,
-    scenario: &Scenario,
-    sim: &mut Simulation,
-    plan: &PlanSummary,
-    end: usize,
-) -> Result<DetailedPath, DetailedJobError> {
-    let robot = sim.robot().clone();
-    let options = MotionOptions::from_params(&prep.params);
-    let end = end.min(plan.path.len());
-    expand_path(&plan.path[..end], &robot, &prep.maps, sim, &options)
-        .map_err(|source| DetailedJobError::Motion { scenario: scenario.name.clone(), source })
 }
 
 /// Writes a recording of the detailed plan: height map, abstract path and keyframes.

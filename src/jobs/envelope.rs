@@ -20,7 +20,7 @@
 //!   simulated-time budget, an error).
 
 use super::check::{self, CheckError, CheckOptions, CheckRow, Finished};
-use super::run::FailureKind;
+use crate::closed_loop::FailureKind;
 use crate::render::{ImageError, RgbImage, write_png};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -498,7 +498,7 @@ mod tests {
             directions: vec![Direction::Up],
             out_dir: PathBuf::from("/nonexistent"),
             check: CheckOptions {
-                run: crate::jobs::run::RunOptions::new(
+                run: crate::closed_loop::RunOptions::new(
                     crate::planner::PlanOptions::default(),
                     PathBuf::from("m.xml"),
                 ),

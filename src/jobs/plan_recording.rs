@@ -4,7 +4,6 @@
 
 use super::costmap::{CostmapError, rasterised_map};
 use crate::cost::CostMaps;
-use crate::path::ManoeuvreKind;
 use crate::planner::PlanSummary;
 use crate::render;
 use crate::robot::RobotDescription;
@@ -47,28 +46,7 @@ pub fn record(
     }
     let poses: Vec<_> = summary.path.iter().map(|e| e.pose).collect();
     rec.log_plan(&poses)?;
-    rec.log_steps(&step_lines(summary))?;
+    rec.log_steps(&crate::viz::step_lines(&summary.path))?;
     rec.finish()?;
     Ok(())
-}
-
-/// Each step of `summary`'s path as a line from the old foot position to its foothold, 2 cm
-/// above the ground, and whether a front leg steps (red) or a rear one (green).
-pub fn step_lines(summary: &PlanSummary) -> Vec<([f64; 3], [f64; 3], bool)> {
-    let mut steps = Vec::new();
-    for pair in summary.path.windows(2) {
-        let (before, after) = (&pair[0], &pair[1]);
-        if after.kind == ManoeuvreKind::Step
-            && let Some(leg) = after.leg
-        {
-            let i = leg.index();
-            let z = |h: Option<f64>| h.unwrap_or(0.0) + 0.02;
-            steps.push((
-                [before.feet[i][0], before.feet[i][1], z(before.foot_heights[i])],
-                [after.feet[i][0], after.feet[i][1], z(after.foot_heights[i])],
-                leg.is_front(),
-            ));
-        }
-    }
-    steps
 }

@@ -2,6 +2,7 @@
 //! posture under a standing controller, optionally driving a constant body twist through
 //! the omnidirectional wheel kinematics, while the stability monitor measures it.
 
+use crate::closed_loop::options::{CONTROL_HZ, SETTLE_S};
 use crate::control::wheels::{Twist, WheelKinematics};
 use crate::geometry::wrap_angle;
 use crate::monitor::{MonitorEvent, MonitorLimits, StabilityMonitor};
@@ -52,10 +53,6 @@ pub struct SimOptions {
     pub progress: bool,
 }
 
-/// Control rate of the standing and driving controller, Hz.
-pub const CONTROL_HZ: f64 = 100.0;
-/// Time after placing the robot before the monitor's minima count (contacts settle), s.
-pub const SETTLE_S: f64 = 0.3;
 /// Linear and angular acceleration limits of the commanded twist, m/s², rad/s².
 const ACCEL_LIMITS: [f64; 2] = [1.0, 2.0];
 /// Recording rate of body poses, Hz.
@@ -129,7 +126,7 @@ pub fn run(scenario: &Scenario, opts: &SimOptions) -> Result<SimSummary, SimJobE
     }
     let mut sim = Simulation::new(scenario, &opts.model_path)?;
     let robot = sim.robot().clone();
-    let (posture, nominal_base_height) = super::stand_at_start(&mut sim, scenario)?;
+    let (posture, nominal_base_height) = crate::closed_loop::stand_at_start(&mut sim, scenario)?;
 
     let mut recorder = match &opts.rerun {
         Some(path) => {

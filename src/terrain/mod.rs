@@ -7,8 +7,10 @@
 
 pub mod heightmap;
 pub mod rasterise;
+pub mod scenario_map;
 pub mod sensed;
 
 pub use heightmap::{HeightMap, HeightMapError, HeightMapView, square_window_max};
 pub use rasterise::{RasteriseError, rasterise, rasterise_into};
+pub use scenario_map::{map_grid, scenario_map};
 pub use sensed::{LaserScanner, RayCaster, RayHit, ScanStats, SensedError};

@@ -13,6 +13,7 @@
 
 use crate::geometry::Pose2;
 use crate::monitor::StabilitySample;
+use crate::path::{ManoeuvreKind, PathElement};
 use crate::render::RgbImage;
 use crate::robot::Leg;
 use crate::sim::{BodyPose, GeomKind, GeomShape};
@@ -604,6 +605,27 @@ impl Recorder {
         }
         Ok(())
     }
+}
+
+/// Each step of `path` as a line from the old foot position to its foothold, 2 cm
+/// above the ground, and whether a front leg steps (red) or a rear one (green).
+pub fn step_lines(path: &[PathElement]) -> Vec<([f64; 3], [f64; 3], bool)> {
+    let mut steps = Vec::new();
+    for pair in path.windows(2) {
+        let (before, after) = (&pair[0], &pair[1]);
+        if after.kind == ManoeuvreKind::Step
+            && let Some(leg) = after.leg
+        {
+            let i = leg.index();
+            let z = |h: Option<f64>| h.unwrap_or(0.0) + 0.02;
+            steps.push((
+                [before.feet[i][0], before.feet[i][1], z(before.foot_heights[i])],
+                [after.feet[i][0], after.feet[i][1], z(after.foot_heights[i])],
+                leg.is_front(),
+            ));
+        }
+    }
+    steps
 }
 
 #[cfg(test)]
