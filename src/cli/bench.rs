@@ -1,0 +1,174 @@
+//! `momaro bench`: planner and simulation speed, as medians over repeats.
+
+use super::args::*;
+use super::report::*;
+use super::suite::suite_files;
+use crate::jobs;
+use anyhow::Context as _;
+
+/// `momaro bench plan`.
+///
+/// # Errors
+/// Bad input, or a job that could not be carried out.
+pub fn bench_plan(args: BenchPlanArgs) -> anyhow::Result<bool> {
+    let BenchPlanArgs {
+        scenario,
+        arastar_limit,
+        optimum_limit,
+        run: BenchRunArgs { repeats, json, model },
+    } = args;
+    let sc = load(&scenario)?;
+    let opts = jobs::bench::BenchOptions {
+        arastar_time_limit_s: arastar_limit,
+        optimum_time_limit_s: optimum_limit,
+        repeats,
+        ..Default::default()
+    };
+    let report = jobs::bench::bench(&sc, &robot(&model.model)?, &opts).map_err(plan_error)?;
+    if json {
+        print_json(&report)?;
+    } else {
+        let pct = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.1} %"));
+        let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{:.1} ms", v * 1e3));
+        let c = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.3}"));
+        say!(
+            "scenario {} (setup {:.1} ms; times are medians of {})",
+            report.scenario,
+            report.setup_time_s * 1e3,
+            opts.repeats
+        );
+        say!(
+            "{:<13} {:<5} {:>10} {:>12} {:>10} {:>10} {:>7} {:>10} {:>10} {:>12} {:>10} {:>10}",
+            "algo",
+            "nbhd",
+            "optimum",
+            "first",
+            "warm first",
+            "over opt",
+            "bound",
+            "cost@1s",
+            "cost@10s",
+            "to optimum",
+            "first exp",
+            "h setup"
+        );
+        for r in &report.rows {
+            say!(
+                "{:<13} {:<5} {:>10} {:>12} {:>10} {:>10} {:>7} {:>10} {:>10} {:>12} {:>10} {:>10}",
+                r.algorithm,
+                r.neighbourhood,
+                c(r.optimum),
+                ms(r.first_solution_s),
+                ms(r.first_solution_warm_s),
+                pct(r.first_over_optimum_pct),
+                r.first_bound.map_or("-".to_owned(), |b| format!("{b:.2}")),
+                c(r.cost_at_1s),
+                c(r.cost_at_10s),
+                ms(r.time_to_optimum_s),
+                r.first_expansions.map_or("-".to_owned(), |e| e.to_string()),
+                ms(Some(r.heuristic_setup_s))
+            );
+        }
+    }
+    Ok(true)
+}
+
+/// `momaro bench probe`.
+///
+/// # Errors
+/// Bad input, or a job that could not be carried out.
+pub fn bench_probe(args: BenchProbeArgs) -> anyhow::Result<bool> {
+    let BenchProbeArgs { paths, time_limit, run: BenchRunArgs { repeats, json, model } } = args;
+    let scenarios =
+        suite_files(&paths)?.iter().map(|f| load(f)).collect::<anyhow::Result<Vec<_>>>()?;
+    let opts = jobs::bench::ProbeBenchOptions { time_limit_s: time_limit, repeats };
+    let (total, width) = (scenarios.len(), scenarios.len().to_string().len());
+    let b = jobs::bench::probe_bench(&scenarios, &robot(&model.model)?, &opts, &mut |done, r| {
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
+            "[{done:>width$}/{total}] {:<24} {:<10} {:>8.1} ms",
+            r.scenario,
+            r.outcome,
+            r.time_s * 1e3
+        );
+    })
+    .map_err(plan_error)?;
+    if json {
+        print_json(&b)?;
+    } else {
+        let ms = |v: Option<f64>| v.map_or("-".to_owned(), |t| format!("{:.1}", t * 1e3));
+        say!(
+            "{:<28} {:<10} {:>10} {:>10} {:>11} {:>12}",
+            "scenario",
+            "outcome",
+            "wall ms",
+            "search ms",
+            "expansions",
+            "cost"
+        );
+        for r in &b.rows {
+            say!(
+                "{:<28} {:<10} {:>10.1} {:>10} {:>11} {:>12}",
+                r.scenario,
+                r.outcome,
+                r.time_s * 1e3,
+                ms(r.search_s),
+                r.expansions.map_or("-".to_owned(), |e| e.to_string()),
+                r.cost.map_or("-".to_owned(), |c| format!("{c:.3}"))
+            );
+        }
+        say!(
+            "{} files, {} with a path (median of {} runs each): wall median {:.1} ms, mean {:.1} ms, largest {:.1} ms; search median {} ms",
+            b.rows.len(),
+            b.paths,
+            b.repeats,
+            b.median_s * 1e3,
+            b.mean_s * 1e3,
+            b.max_s * 1e3,
+            ms(b.median_search_s)
+        );
+    }
+    Ok(true)
+}
+
+/// `momaro bench sim`.
+///
+/// # Errors
+/// Bad input, or a job that could not be carried out.
+pub fn bench_sim(args: BenchSimArgs) -> anyhow::Result<bool> {
+    let BenchSimArgs { scenario, duration, repeats, json, model } = args;
+    let sc = load(&scenario)?;
+    let opts = jobs::sim::SimOptions {
+        duration_s: duration,
+        drive: None,
+        model_path: model.model,
+        rerun: None,
+        progress: false,
+    };
+    let b = jobs::bench::sim_bench(&sc, &opts, repeats)
+        .with_context(|| format!("bench sim {}", scenario.display()))?;
+    if json {
+        print_json(&b)?;
+    } else {
+        say!(
+            "scenario            {} ({} s simulated, {} steps, median of {})",
+            b.scenario,
+            b.sim_time_s,
+            b.steps,
+            b.repeats
+        );
+        say!(
+            "bare mj_step loop   x{:.1} real time ({:.2} µs/step)",
+            b.bare_real_time_factor,
+            b.bare_step_us
+        );
+        say!(
+            "momaro sim          x{:.1} real time ({:.2} µs/step)",
+            b.controlled_real_time_factor,
+            b.controlled_step_us
+        );
+        say!("controller+monitor  {:.1} % of a step", b.overhead_fraction * 100.0);
+    }
+    Ok(true)
+}
