@@ -21,8 +21,8 @@
 //!
 //! Stepping uses the standing rule of `posture::standing` (its step heights are what the
 //! planner's reach check and the generator's step candidates share), and the planner runs
-//! the generator's own step check (`motion::expand::ManoeuvreCheck::step`) on the steps it admits,
-//! and its own wheel-move and base-shift expansions (`ManoeuvreCheck::wheel_move`,
+//! the generator's own step check (`motion::manoeuvres::step::check`) on the steps it admits,
+//! and its own wheel-move and base-shift expansions (`wheel_move::check`,
 //! `base_shift`) on the moves and shifts it admits; a wheel move between two
 //! cells whose postures both clear the swept leg terrain needs none, by the argument
 //! above.

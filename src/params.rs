@@ -123,7 +123,7 @@ pub struct Params {
     pub arastar_initial_epsilon: f64,
     /// ARA*: factor by which ε − 1 shrinks after each solution (exponential decay).
     pub arastar_epsilon_decay: f64,
-    /// ARA*: ε of a greedy probe searched before the paper's schedule (`planner::arastar`),
+    /// ARA*: ε of a greedy probe searched before the paper's schedule (`search::arastar`),
     /// whose solution is kept, with its certified bound, for when a limit stops the
     /// schedule. Not in the paper; at most `arastar_initial_epsilon` turns it off. 50:
     /// on seed 1's 13 generated up-and-over courses it finds a path in 0.2–1.5 s each,
@@ -202,7 +202,7 @@ impl FootModel {
 
 /// Which manoeuvres prepare a step, written `step_model = "paper"` or
 /// `step_model = "stairs"` in a scenario's `[params]`. With either, a step is planned
-/// only where the motion generator's own check expands it (`locomotion::hybrid`).
+/// only where the motion generator's own check expands it (`motion::manoeuvres`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StepModel {

@@ -2,7 +2,7 @@
 //! few draws the crate needs (uniform, ranges, integers, normals).
 //!
 //! Everything random in momaro must be reproducible from a seed on any machine and
-//! compiler: noisy pose feedback in `jobs::run` and the scenario generator
+//! compiler: noisy pose feedback in `closed_loop` and the scenario generator
 //! (`scenario::generate`). So the generator is written out here rather than taken from a
 //! crate whose streams may change between versions: the same seed gives the same
 //! sequence forever (unit tests pin the first values).

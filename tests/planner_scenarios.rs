@@ -503,7 +503,7 @@ fn the_probe_answers_where_the_schedule_runs_out() {
     assert!(!steps(&p).is_empty(), "the course is climbed");
 }
 
-/// The guided probe (issue 15, `planner::arastar` docs): generated flights with open
+/// The guided probe (issue 15, `search::arastar` docs): generated flights with open
 /// sides (`generate --class stairs --seed 4`: 2 × 0.182 m at 106°; `--seed 11`: 6 ×
 /// 0.195 m, a landing, at −9°). The probe ordered by the admissible heuristic alone
 /// searches the floor beside the flight, where the base-pose cost-to-go is lowest but the
@@ -546,7 +546,7 @@ fn the_probe_steps_down_0_3_m_without_first_searching_the_whole_platform() {
     assert_eq!(steps(&p).len(), 4, "every foot steps down once");
 }
 
-/// The feet's way over climbable terrain in the probe's greedy list (`locomotion::way`): on
+/// The feet's way over climbable terrain in the probe's greedy list (`planner::heuristic::way`): on
 /// a generated flight with open sides (`generate --class stairs --seed 9`, CI's
 /// `stairs_000009`: 5 × 0.176 m at −56.5°, a landing after step 3) the probe's first two
 /// steps went up at headings from which the third fails, and its lists, the greedy one

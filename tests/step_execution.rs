@@ -322,7 +322,7 @@ fn stairwell_whole_mission_in_closed_loop() {
     // feet span. The planner searched every reachable pose without a path: with the
     // front feet on a tread at or behind neutral and a rear foot short of the first
     // riser, no manoeuvre brought that foot up to the riser or the base forward. The
-    // partial foot to neutral and the climb shift (`locomotion::hybrid`) do.
+    // partial foot to neutral and the climb shift (`motion::manoeuvres`) do.
     let s = run_whole("stairs_stairwell");
     assert_eq!(s.steps_planned, 16);
 }

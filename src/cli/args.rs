@@ -6,7 +6,8 @@ use crate::scenario::generate::Class;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
-/// Closed-loop simulator of hybrid driving-stepping locomotion for Momaro (Klamt & Behnke, IROS 2017).
+/// Closed-loop simulator of hybrid driving-stepping locomotion for Momaro (Klamt & Behnke,
+/// IROS 2017).
 #[derive(Debug, Parser)]
 #[command(name = "momaro", version, about)]
 pub struct Cli {

@@ -2,7 +2,7 @@
 //! unchanged: two rectangles of the same size get the same print exactly when (up to a
 //! collision, see below) every layer of [`CostMaps`] holds the same values in both, cell
 //! by cell. The planner uses them to answer a step check from an earlier one at the same
-//! stance on the same terrain elsewhere (`locomotion::hybrid`, "Translated step
+//! stance on the same terrain elsewhere (`motion::manoeuvres::step`, "Translated step
 //! failures"): a straight edge, a stair's riser or a wall is the same terrain along its
 //! whole length.
 //!

@@ -271,7 +271,7 @@ pub struct BenchRow {
     pub first_solution_s: Option<f64>,
     /// Time to the first solution of the same search run again on the heuristic tables
     /// the first run left (as a replan or a retry of `run` finds them,
-    /// `locomotion::HeuristicCache`): the search without the heuristic's set-up and
+    /// `planner::HeuristicCache`): the search without the heuristic's set-up and
     /// first query, s. Measured for `arastar+probe` (the first path, as `plan` finds it).
     pub first_solution_warm_s: Option<f64>,
     /// Its cost.

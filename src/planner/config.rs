@@ -58,10 +58,10 @@ pub struct HybridConfig {
     pub motion: MotionOptions,
 }
 
-/// Margin the planner's step check requires beyond the generator's, m: the
-/// planner's CoM estimate (`posture::standing::EstimatedCom`) is MuJoCo's to a micrometre with the wheels
-/// level, but the roll of eqs. 6–8 is iterated to 3 mm of its target with either model,
-/// so the generator's roll may differ slightly from the planner's.
+/// Margin the planner's step check requires beyond the generator's, m: the planner's CoM
+/// estimate (`posture::standing::EstimatedCom`) is MuJoCo's to a micrometre with the wheels
+/// level, but the roll of eqs. 6–8 is iterated to 3 mm of its target with either model, so
+/// the generator's roll may differ slightly from the planner's.
 pub const PLANNER_MARGIN_SLACK_M: f64 = 0.003;
 
 impl HybridConfig {

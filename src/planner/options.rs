@@ -72,7 +72,7 @@ pub struct PlanOptions {
     /// Driving neighbourhood; default N16 for A*, N20 for ARA* (Sec. VII-B).
     pub neighbourhood: Option<Neighbourhood>,
     /// Edges to leave out: manoeuvres the motion generator could not expand in an
-    /// earlier plan of the same run (`jobs::run::plan_mission`).
+    /// earlier plan of the same run (`closed_loop::plan_mission`).
     pub forbidden: Vec<(PoseKey, PoseKey)>,
 }
 

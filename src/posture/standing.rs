@@ -1,5 +1,5 @@
 //! The leg-height rule for standing manoeuvres (Sec. VI-B), shared by the planner's
-//! reach checks (`locomotion::hybrid`) and the step motion generator (`motion::expand`),
+//! reach checks (`motion::manoeuvres`) and the step motion generator (`motion::expander`),
 //! so every footprint the planner admits is one the generator can stand in.
 //!
 //! Sec. VI-B: for manoeuvres other than driving, "the base height is determined by the
@@ -540,7 +540,7 @@ pub fn solved_com_estimate(robot: &RobotDescription, p: &Posture, legs: &SolvedL
 }
 
 /// [`com_estimate`]'s lumped masses as a [`CenterOfMassModel`]: the motion generator's
-/// checks, run by the planner without MuJoCo (`locomotion::hybrid`'s step and wheel-move
+/// checks, run by the planner without MuJoCo (`motion::manoeuvres`' step and wheel-move
 /// checks). The foot mass sits at the wheel axle, which the leg's forward kinematics
 /// gives; its height (which only the roll of eqs. 6–8 uses) is the axle's.
 #[derive(Debug, Clone, Copy)]

@@ -1,7 +1,7 @@
 //! The one interface between the search and a problem: [`SearchGraph`].
 //!
 //! As in SBPL, the search knows states only as opaque values; the graph (the paper's
-//! "neighbour client", the hybrid pose lattice in `locomotion`) owns coordinates,
+//! "neighbour client", the hybrid pose lattice in `planner`) owns coordinates,
 //! successors, costs and the heuristic. Nothing here knows about robots.
 
 use super::Cost;

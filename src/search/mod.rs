@@ -1,6 +1,6 @@
 //! Generic graph search: A* and ARA* over a small trait. Knows nothing of robots.
 //!
-//! The hybrid locomotion planner (`locomotion`) implements [`SearchGraph`] for its pose
+//! The hybrid locomotion planner (`planner`) implements [`SearchGraph`] for its pose
 //! lattice (the paper's "neighbour client") and calls [`astar`] or [`arastar`]
 //! (Klamt & Behnke 2017, Sec. V and VII-B). The design follows SBPL's split — the search
 //! knows states only as opaque values, the graph owns successors, costs and the
@@ -39,7 +39,7 @@
 //! assert_eq!(result.termination, Termination::OptimalProven);
 //! ```
 
-pub mod cost;
+pub mod fixed_point;
 pub mod graph;
 pub mod params;
 pub mod result;
@@ -55,7 +55,7 @@ mod tests;
 
 pub use arastar::{arastar, arastar_with_hooks};
 pub use astar::{astar, astar_with_hooks};
-pub use cost::Cost;
+pub use fixed_point::Cost;
 pub use graph::SearchGraph;
 pub use nodes::{FxBuild, FxHasher};
 pub use params::{Algorithm, EPS_SCALE, ParamsError, SearchParams};

@@ -15,7 +15,7 @@ pub struct Solution<S> {
     pub cost: Cost,
     /// The heuristic weight ε of the search that produced it (1.0 for A*). The cost is
     /// at most ε times the optimal cost (for a consistent heuristic), except for ARA*'s
-    /// guided probe, which may stop sooner (`planner::engine`, "Guided search").
+    /// guided probe, which may stop sooner (`search::engine`, "Guided search").
     pub epsilon: f64,
     /// The bound it carries, `min(ε, ε′)` with `ε′ = cost / min_{s ∈ OPEN ∪ INCONS}(g(s) +
     /// h(s))` (Likhachev et al. 2003, Sec. 4), or ε′ alone for a guided probe's path (then

@@ -36,22 +36,22 @@ use crate::posture::kinematics::{Posture, hips_in_world, interpolate};
 pub(super) const WHEEL_REST_RANGE_M: f64 = 0.05;
 
 impl StepExecutor {
-    /// `p` with each foot at the height where its wheel pair rests on the height map
-    /// (the higher of its two wheels, [`crate::terrain::HeightMap::wheel_rest_height`], with the pair
-    /// turned by its measured steering), within [`WHEEL_REST_RANGE_M`] of the keyframes'
-    /// height: legs lengthen and shorten with the ground under the wheels, so every
-    /// wheel keeps the ground over bumps the foot cost lets the robot drive on, rather
-    /// than the stiff legs lifting a diagonal off it. The base rises where a foot would
-    /// otherwise stand closer under its hip than the driving leg height (the knees fold
-    /// nearly to their limit there): by the most any foot rises beyond its leg's
+    /// `p` with each foot at the height where its wheel pair rests on the height map (the
+    /// higher of its two wheels, [`crate::terrain::HeightMap::wheel_rest_height`], with the
+    /// pair turned by its measured steering), within [`WHEEL_REST_RANGE_M`] of the
+    /// keyframes' height: legs lengthen and shorten with the ground under the wheels, so
+    /// every wheel keeps the ground over bumps the foot cost lets the robot drive on,
+    /// rather than the stiff legs lifting a diagonal off it. The base rises where a foot
+    /// would otherwise stand closer under its hip than the driving leg height (the knees
+    /// fold nearly to their limit there): by the most any foot rises beyond its leg's
     /// [`Self::leg_slack`]. A driving posture sets the base by its highest foot
     /// (`posture::kinematics::driving_posture`), so only that leg is at the driving height;
-    /// a wheel resting on the edge of a bump the plan has it already off is taken up by
-    /// its longer leg. (The base rose by each foot's whole rise before: a front pair
-    /// rolling off a 4.3 cm box, its wheels still on the edge where the map had its foot
-    /// on the floor, raised the base 3.5 cm while its partner stood on the box, and the
-    /// rise and the load sharing's push threw every wheel off the ground: generated
-    /// clutter seed 12067, the CoM 2.7 cm outside the support of the first wheels down.)
+    /// a wheel resting on the edge of a bump the plan has it already off is taken up by its
+    /// longer leg. (The base rose by each foot's whole rise before: a front pair rolling
+    /// off a 4.3 cm box, its wheels still on the edge where the map had its foot on the
+    /// floor, raised the base 3.5 cm while its partner stood on the box, and the rise and
+    /// the load sharing's push threw every wheel off the ground: generated clutter seed
+    /// 12067, the CoM 2.7 cm outside the support of the first wheels down.)
     fn on_wheel_rest_heights(&self, mut p: Posture, obs: &Observation) -> Posture {
         let mut rise = 0.0_f64;
         let r = self.robot.wheel_radius;

@@ -1,4 +1,4 @@
-//! What the step executor exchanges with its caller (`jobs::run`): its tuning
+//! What the step executor exchanges with its caller (`closed_loop`): its tuning
 //! ([`ExecutorConfig`]), what it sees each tick ([`Observation`]), the actuator targets it
 //! returns ([`Command`]), its status ([`ExecStatus`]), why it left the plan
 //! ([`ExecFailure`]) and the events it records for the run's summary ([`ExecEvent`]).

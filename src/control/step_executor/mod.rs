@@ -4,7 +4,7 @@
 //! A pure state machine: each tick it takes an [`Observation`] (measured base pose,
 //! joints, steering, MuJoCo's CoM, the wheels MuJoCo reports touching terrain or within
 //! the monitor's support gap, and the load on each wheel pair) and returns actuator
-//! targets ([`Command`]). The simulation loop lives in `jobs::run`.
+//! targets ([`Command`]). The simulation loop lives in `closed_loop`.
 //!
 //! - **Drive** runs (consecutive [`Phase::Drive`] keyframes) go to the B-spline
 //!   [`PathFollower`] (Sec. IX) and the omnidirectional wheel kinematics; the legs hold the

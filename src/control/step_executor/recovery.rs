@@ -1,6 +1,6 @@
 //! Leaving the plan: on a failure a lifted foot is put down first, then the robot returns
 //! to the driving posture at its pose (from the height map, feet rolled to the neutral
-//! footprint) and stops, so that `jobs::run` can replan. Where a wheel would meet an edge
+//! footprint) and stops, so that `closed_loop` can replan. Where a wheel would meet an edge
 //! on its way back (a height change more than a driving wheel meets, as mid-flight on a
 //! staircase, where feet stand a tread apart), the robot holds its stance instead and
 //! reports itself stranded: rolling a wheel pair off a tread drops that corner, and on a

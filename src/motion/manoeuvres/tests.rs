@@ -851,7 +851,7 @@ fn a_platform_three_0_1_m_rises_high_is_within_the_step_height() {
 
 /// Checks `h(s) ≤ c(s, t) + h(t)` on every labelled successor of `s` and on every
 /// edge the search itself takes out of `s` and out of the lazy steps' intermediate
-/// nodes it reaches (`hybrid` module docs, "Lazy step checks"); returns the labelled
+/// nodes it reaches (`motion::manoeuvres::step`, "Lazy step checks"); returns the labelled
 /// successors.
 fn check_consistent(
     g: &mut HybridGraph<'_>,
@@ -999,7 +999,7 @@ fn random_box() -> impl proptest::strategy::Strategy<Value = (f64, f64, f64, f64
 
 /// The hybrid graph with the heuristic before the cost-to-go (issue 15): the
 /// Euclidean-plus-turn part and the step bound (consistent on their own, see the
-/// `hybrid` module docs). A reference for the optimum. It searches the graph's
+/// `motion::manoeuvres`). A reference for the optimum. It searches the graph's
 /// checked edges (`labelled_successors`), without the intermediate nodes of lazy
 /// step checks: on such a node this heuristic, its pose's, is not consistent (the
 /// edge into the node has paid the step's least cost already), and A* with it

@@ -461,8 +461,9 @@ impl Expander<'_> {
     /// The wheel move of one foot to `foot` (x, y on the ground), the base standing by the
     /// shared rule at its current place: through every cell of the way (a keyframe per
     /// height-map cell the foot rolls over), the base re-stood by the rule at each, as the
-    /// planner checked the move (every footprint of the way can stand). A single keyframe at the end let the interpolation between the two ends
-    /// dip a knee below the legs' clearance that both ends kept.
+    /// planner checked the move (every footprint of the way can stand). A single keyframe
+    /// at the end let the interpolation between the two ends dip a knee below the legs'
+    /// clearance that both ends kept.
     pub(crate) fn expand_wheel_move(
         &mut self,
         kind: ManoeuvreKind,

@@ -7,11 +7,12 @@
 //! graph. `HybridGraph::heuristic` takes `max(Euclidean + turn, D)` and adds the step
 //! bound and the foot-offset potential of `heuristic`.
 //!
-//! **Which edges move the base.** Of the hybrid graph's manoeuvres (`hybrid` module
-//! docs) drives, turns on the spot and base shifts change the base pose. Abstract steps,
-//! "front foot forward" and "foot to neutral" leave it where it is, so `D` is the same at
-//! both ends of those edges and `D(s) ≤ c(s, t) + D(t)` holds for any cost `c ≥ 0`
-//! (their costs are what the step bound and the foot-offset potential bound).
+//! **Which edges move the base.** Of the hybrid graph's manoeuvres (`planner::graph` and
+//! the units of `motion::manoeuvres`) drives, turns on the spot and base shifts change the
+//! base pose. Abstract steps, "front foot forward" and "foot to neutral" leave it where it
+//! is, so `D` is the same at both ends of those edges and `D(s) ≤ c(s, t) + D(t)` holds for
+//! any cost `c ≥ 0` (their costs are what the step bound and the foot-offset potential
+//! bound).
 //!
 //! **Drive and turn edges** (`driving` module docs, eq. 4, Fig. 8). A drive by move `m`
 //! from (a, θ) to (b, θ) costs `L_m · k_Δθ · (C(a, θ) + C(b, θ)) / 2` and a turn from
@@ -26,7 +27,7 @@
 //!
 //! **Base-shift edges.** A base shift by `l` cells along the heading θ moves the base
 //! from the centre of cell a to `a + l · res · (cos θ, sin θ)` and snaps it to the cell b
-//! holding that point (`hybrid` module docs). The cell of the exact position after k
+//! holding that point (`motion::manoeuvres::base_shift`). The cell of the exact position after k
 //! cell-lengths is `⌊1/2 + k · cos θ⌋` cells from a along x (likewise y), so from one k
 //! to the next each axis steps by 0 or by the sign of its direction cosine: a chain of at
 //! most l *forward links* of layer θ (the up to three steps into the heading's quadrant)

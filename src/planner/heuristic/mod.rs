@@ -39,10 +39,11 @@
 //!    eq. 6 (C_F ≥ the map's smallest), steps by the share λ of eq. 5's k7 term that `S`
 //!    leaves out; a base shift raises Φ (`step_bound::offset_potential`).
 //!
-//! `S` is zero where no step is needed and Φ for the neutral footprint. The proofs are
-//! in the `cost_to_go` and `step_bound` module docs; the manoeuvres' tests
-//! (`motion::manoeuvres`) check `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre near a platform edge and
-//! on random walks over random small maps, and that A*'s optimum does not change.
+//! `S` is zero where no step is needed and Φ for the neutral footprint. The proofs are in
+//! the `cost_to_go` and `step_bound` module docs; the manoeuvres' tests
+//! (`motion::manoeuvres`) check `h(s) ≤ c(s, t) + h(t)` on sampled edges of every manoeuvre
+//! near a platform edge and on random walks over random small maps, and that A*'s optimum
+//! does not change.
 
 pub mod cost_to_go;
 pub mod parts;
