@@ -12,7 +12,7 @@ use momaro::cost::{CostMaps, FootCostLayer};
 use momaro::geometry::Pose2;
 use momaro::params::Params;
 use momaro::robot::RobotDescription;
-use momaro::scenario::terrain::Primitive;
+use momaro::scenario::terrain::{Block, Pole, Primitive, Ramp, Stairs};
 use momaro::terrain::{HeightMap, rasterise};
 
 /// Test robot with Momaro-like proportions (the real numbers come from the model).
@@ -36,10 +36,15 @@ impl Rng {
 
 fn scene() -> Vec<Primitive> {
     let mut ps = vec![
-        Primitive::Box { center: [4.0, 0.0], size: [3.0, 4.0], height: 0.2, yaw_deg: 0.0 },
-        Primitive::Ramp { center: [1.75, 3.0], size: [1.5, 2.0], height: 0.2, yaw_deg: 0.0 },
-        Primitive::Ramp { center: [-5.0, -5.0], size: [2.0, 1.5], height: 0.3, yaw_deg: 35.0 },
-        Primitive::Stairs {
+        Primitive::Box(Block { center: [4.0, 0.0], size: [3.0, 4.0], height: 0.2, yaw_deg: 0.0 }),
+        Primitive::Ramp(Ramp { center: [1.75, 3.0], size: [1.5, 2.0], height: 0.2, yaw_deg: 0.0 }),
+        Primitive::Ramp(Ramp {
+            center: [-5.0, -5.0],
+            size: [2.0, 1.5],
+            height: 0.3,
+            yaw_deg: 35.0,
+        }),
+        Primitive::Stairs(Stairs {
             start: [-3.0, 5.0],
             width: 1.2,
             steps: 4,
@@ -47,20 +52,24 @@ fn scene() -> Vec<Primitive> {
             step_height: 0.15,
             landing_depth: 1.0,
             yaw_deg: 90.0,
-        },
+        }),
     ];
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     for k in 0..36 {
         let c = [rng.range(-9.0, 9.0), rng.range(-9.0, 9.0)];
         ps.push(if k % 2 == 0 {
-            Primitive::Pole { center: c, radius: rng.range(0.03, 0.1), height: rng.range(0.1, 0.8) }
+            Primitive::Pole(Pole {
+                center: c,
+                radius: rng.range(0.03, 0.1),
+                height: rng.range(0.1, 0.8),
+            })
         } else {
-            Primitive::Box {
+            Primitive::Box(Block {
                 center: c,
                 size: [rng.range(0.2, 1.0), rng.range(0.2, 1.0)],
                 height: rng.range(0.03, 0.4),
                 yaw_deg: rng.range(0.0, 90.0),
-            }
+            })
         });
     }
     ps

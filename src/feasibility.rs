@@ -364,11 +364,13 @@ mod tests {
         // reaches over the wall: the pose a planned path once drove through and the
         // motion generator rejected.
         let robot = RobotDescription::reference();
-        let wall = |y: f64| crate::scenario::Primitive::Box {
-            center: [1.8, y],
-            size: [0.2, 1.5],
-            height: 1.0,
-            yaw_deg: 0.0,
+        let wall = |y: f64| {
+            crate::scenario::Primitive::Box(crate::scenario::terrain::Block {
+                center: [1.8, y],
+                size: [0.2, 1.5],
+                height: 1.0,
+                yaw_deg: 0.0,
+            })
         };
         let hm =
             crate::terrain::rasterise(&[wall(1.26), wall(-1.26)], [0.0, -2.0], [3.5, 4.0], 0.025)

@@ -264,7 +264,7 @@ mod tests {
     use super::*;
     use crate::params::Params;
     use crate::robot::RobotDescription;
-    use crate::scenario::terrain::Primitive;
+    use crate::scenario::terrain::{Pole, Primitive, Ramp};
     use crate::terrain::rasterise;
 
     fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
@@ -353,9 +353,14 @@ mod tests {
     #[test]
     fn all_layers_of_a_scene_are_written() {
         let ps = [
-            Primitive::Ramp { center: [1.0, 1.5], size: [1.0, 0.8], height: 0.2, yaw_deg: 0.0 },
-            Primitive::Pole { center: [2.0, 1.0], radius: 0.05, height: 0.15 },
-            Primitive::Pole { center: [2.0, 2.0], radius: 0.05, height: 0.5 },
+            Primitive::Ramp(Ramp {
+                center: [1.0, 1.5],
+                size: [1.0, 0.8],
+                height: 0.2,
+                yaw_deg: 0.0,
+            }),
+            Primitive::Pole(Pole { center: [2.0, 1.0], radius: 0.05, height: 0.15 }),
+            Primitive::Pole(Pole { center: [2.0, 2.0], radius: 0.05, height: 0.5 }),
         ];
         let mut m = rasterise(&ps, [0.0, 0.0], [3.0, 3.0], 0.025).unwrap();
         for j in 100..120 {

@@ -5,6 +5,7 @@ mod common;
 
 use momaro::robot::Leg;
 use momaro::robot::ik::{leg_fk, leg_ik};
+use momaro::scenario::terrain::Solid;
 use momaro::sim::Simulation;
 
 #[test]
@@ -217,11 +218,12 @@ fn terrain_solids_in_bodies_of_their_own_are_drawn_and_found_as_before() {
     let shapes = sim.geom_shapes();
     let mut blocks = 0;
     for (i, prim) in sc.terrain.iter().enumerate() {
-        for (k, b) in prim.blocks().iter().enumerate() {
+        for (k, solid) in prim.solids().iter().enumerate() {
+            let Solid::Box { center, height, .. } = *solid else { continue };
             let name = format!("terrain_{i}_{k}");
             let g = shapes.iter().find(|g| g.name == name).expect("a geom per block");
             assert_eq!(g.body, 0, "{name}");
-            let expected = [b.center[0], b.center[1], b.height / 2.0];
+            let expected = [center[0], center[1], height / 2.0];
             let off = (0..3).map(|c| (g.local_position[c] - expected[c]).abs()).fold(0.0, f64::max);
             assert!(off < 1e-9, "{name}: {g:?}");
             blocks += 1;

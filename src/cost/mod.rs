@@ -640,7 +640,7 @@ impl CostMaps {
 mod tests {
     use super::*;
     use crate::robot::Range;
-    use crate::scenario::terrain::Primitive;
+    use crate::scenario::terrain::{Block, Pole, Primitive};
     use crate::terrain::rasterise;
 
     const RES: f64 = 0.025;
@@ -689,9 +689,19 @@ mod tests {
     #[test]
     fn a_driving_stencil_gives_the_driving_pose_cost_bit_for_bit() {
         let prims = [
-            Primitive::Box { center: [1.2, 0.9], size: [0.6, 0.5], height: 0.2, yaw_deg: 17.0 },
-            Primitive::Box { center: [2.3, 0.5], size: [0.3, 0.3], height: 0.06, yaw_deg: 0.0 },
-            Primitive::Pole { center: [0.7, 1.4], radius: 0.05, height: 0.12 },
+            Primitive::Box(Block {
+                center: [1.2, 0.9],
+                size: [0.6, 0.5],
+                height: 0.2,
+                yaw_deg: 17.0,
+            }),
+            Primitive::Box(Block {
+                center: [2.3, 0.5],
+                size: [0.3, 0.3],
+                height: 0.06,
+                yaw_deg: 0.0,
+            }),
+            Primitive::Pole(Pole { center: [0.7, 1.4], radius: 0.05, height: 0.12 }),
         ];
         let m = rasterise(&prims, [0.0, 0.0], [3.0, 2.0], RES).unwrap();
         let robot = RobotDescription::reference();
@@ -756,7 +766,8 @@ mod tests {
     #[test]
     fn low_pole_between_the_legs_costs_nothing() {
         // 0.15 m < 0.22 m clearance; 0.49 m from every foot (> r_N), so no foot cost.
-        let maps = maps_of(&[Primitive::Pole { center: [2.5, 2.5], radius: 0.05, height: 0.15 }]);
+        let maps =
+            maps_of(&[Primitive::Pole(Pole { center: [2.5, 2.5], radius: 0.05, height: 0.15 })]);
         let d = maps.pose_cost_detail(&CENTRE, &maps.neutral_feet(&CENTRE), &[0.27; 4]);
         assert_eq!(d.feet, [Cost::Finite(1.0); 4]);
         assert_eq!(d.body, Cost::Finite(1.0));
@@ -767,7 +778,8 @@ mod tests {
 
     #[test]
     fn tall_pole_under_the_base_costs_k2_times_missing_clearance() {
-        let maps = maps_of(&[Primitive::Pole { center: [2.5, 2.5], radius: 0.05, height: 0.4 }]);
+        let maps =
+            maps_of(&[Primitive::Pole(Pole { center: [2.5, 2.5], radius: 0.05, height: 0.4 })]);
         let d = maps.pose_cost_detail(&CENTRE, &maps.neutral_feet(&CENTRE), &[0.27; 4]);
         // C_B = 1 + k2 · (0.4 − (0 + 0.27 − 0.05)) = 1.18.
         assert!((finite(d.body) - 1.18).abs() < 1e-12, "{d:?}");
@@ -824,12 +836,12 @@ mod tests {
         // A 0.3 m platform from x = 2.7125 on: the front feet (x = 2.9625) stand on it,
         // the rear feet (2.0625) do not, and the front circle's disc (centre 2.7125,
         // radius 0.25) reaches onto it.
-        let maps = maps_of(&[Primitive::Box {
+        let maps = maps_of(&[Primitive::Box(Block {
             center: [3.85, 2.5],
             size: [2.3, 5.0],
             height: 0.3,
             yaw_deg: 0.0,
-        }]);
+        })]);
         let feet = maps.neutral_feet(&CENTRE);
         // Hips: front 0.3 + 0.27, rear 0.27; underside at the front circle (x' = 0.2):
         // 0.27 + 0.3 · (0.5 / 0.6) − 0.05 = 0.47 > 0.3: no clearance cost.
@@ -847,12 +859,12 @@ mod tests {
     fn edges_at_the_feet_are_infinite_or_finite_by_height() {
         // An edge at x = 3.05, 0.0875 m in front of the front feet (x = 2.9625).
         let edge = |h: f64| {
-            maps_of(&[Primitive::Box {
+            maps_of(&[Primitive::Box(Block {
                 center: [4.0, 2.5],
                 size: [1.9, 5.0],
                 height: h,
                 yaw_deg: 0.0,
-            }])
+            })])
         };
         let feet = |m: &CostMaps| m.pose_cost_detail(&CENTRE, &m.neutral_feet(&CENTRE), &[0.27; 4]);
         let high = edge(0.06);
@@ -873,8 +885,12 @@ mod tests {
         // A 0.17 m step whose edge lies at x = 3.075: ΔH marks cells 122 (centre
         // 3.0625) and 123. The front feet stand on cell 118 (centre 2.9625), 4 cells =
         // 0.1 m from the nearest marked cell.
-        let prims =
-            [Primitive::Box { center: [4.025, 2.5], size: [1.9, 5.0], height: 0.17, yaw_deg: 0.0 }];
+        let prims = [Primitive::Box(Block {
+            center: [4.025, 2.5],
+            size: [1.9, 5.0],
+            height: 0.17,
+            yaw_deg: 0.0,
+        })];
         let m = rasterise(&prims, [0.0, 0.0], [5.0, 5.0], RES).unwrap();
         let paper = CostMaps::build(&m, &robot(), &Params::default()).unwrap();
         let wp_params = Params { foot_model: FootModel::WheelPair, ..Params::default() };
@@ -930,7 +946,8 @@ mod tests {
 
     #[test]
     fn layers_cover_the_map() {
-        let maps = maps_of(&[Primitive::Pole { center: [2.5, 2.5], radius: 0.05, height: 0.4 }]);
+        let maps =
+            maps_of(&[Primitive::Pole(Pole { center: [2.5, 2.5], radius: 0.05, height: 0.4 })]);
         let body = maps.body_cost_layer(0.0, 0.27);
         let pose = maps.pose_cost_layer(0.0, 0.27);
         assert_eq!(body.len(), 200 * 200);

@@ -158,7 +158,7 @@ mod tests {
     use super::*;
     use crate::params::Params;
     use crate::robot::RobotDescription;
-    use crate::scenario::terrain::Primitive;
+    use crate::scenario::terrain::{Block, Primitive};
     use crate::terrain::rasterise::rasterise;
 
     fn maps(prims: &[Primitive]) -> CostMaps {
@@ -167,7 +167,7 @@ mod tests {
     }
 
     fn block(x: f64, y: f64) -> Primitive {
-        Primitive::Box { center: [x, y], size: [0.2, 0.3], height: 0.15, yaw_deg: 0.0 }
+        Primitive::Box(Block { center: [x, y], size: [0.2, 0.3], height: 0.15, yaw_deg: 0.0 })
     }
 
     #[test]
@@ -223,12 +223,12 @@ mod tests {
         let low = maps(&[block(1.0, 1.0)]);
         let high = maps(&[
             block(1.0, 1.0),
-            Primitive::Box {
+            Primitive::Box(Block {
                 center: [2.0125, 0.5125],
                 size: [0.025, 0.025],
                 height: 0.01,
                 yaw_deg: 0.0,
-            },
+            }),
         ]);
         let (pl, ph) = (TerrainPrints::new(&low, 0), TerrainPrints::new(&high, 0));
         assert_ne!(pl.print([70, 90], [10, 30]), ph.print([70, 90], [10, 30]));

@@ -125,7 +125,7 @@ pub fn checked_case(
     let mut reason = String::new();
     for _ in 0..MAX_TRIES {
         let case = draws.next_case()?;
-        let text = case.to_toml();
+        let text = case.to_toml()?;
         let path = dir.join(case.file_name());
         match Scenario::parse(&text, &path) {
             Ok(scenario) => {

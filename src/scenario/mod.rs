@@ -17,11 +17,13 @@
 //! needs 2 cm more than the disc, and doorways that the robot drove through it stepped
 //! through. A file that names a model gets it.
 
+mod field;
 pub mod generate;
 pub mod terrain;
 
 use crate::geometry::Pose2;
 use crate::params::{FootModel, Params, StepModel};
+use field::{FieldError, finite, non_negative, positive};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 pub use terrain::Primitive;
@@ -221,13 +223,7 @@ pub fn default_models(terrain: &[Primitive]) -> (FootModel, StepModel) {
 
 /// The most steps of any `stairs` primitive of `terrain`; `None` without stairs.
 pub fn longest_flight(terrain: &[Primitive]) -> Option<u32> {
-    terrain
-        .iter()
-        .filter_map(|p| match p {
-            Primitive::Stairs { steps, .. } => Some(*steps),
-            _ => None,
-        })
-        .max()
+    terrain.iter().filter_map(Primitive::flight_steps).max()
 }
 
 /// A loaded, validated scenario.
@@ -315,32 +311,6 @@ impl Scenario {
     }
 }
 
-type FieldError = (String, String);
-
-fn finite(field: &str, v: f64) -> Result<(), FieldError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err((field.to_owned(), format!("{v} is not a finite number")))
-    }
-}
-
-fn positive(field: &str, v: f64) -> Result<(), FieldError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err((field.to_owned(), format!("{v} must be a finite number > 0")))
-    }
-}
-
-fn non_negative(field: &str, v: f64) -> Result<(), FieldError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err((field.to_owned(), format!("{v} must be a finite number >= 0")))
-    }
-}
-
 fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
     let m = &f.map;
     for (name, v) in [
@@ -394,7 +364,7 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
         }
     }
     for (i, prim) in f.terrain.iter().enumerate() {
-        validate_primitive(&format!("terrain[{i}]"), prim)?;
+        prim.validate(&format!("terrain[{i}]"))?;
     }
     f.params
         .validate()
@@ -452,47 +422,6 @@ fn validate(f: &ScenarioFile) -> Result<(), FieldError> {
         ));
     }
     positive("expect.timeout_s", e.timeout_s)?;
-    Ok(())
-}
-
-fn validate_primitive(at: &str, p: &Primitive) -> Result<(), FieldError> {
-    match *p {
-        Primitive::Box { center, size, height, yaw_deg }
-        | Primitive::Ramp { center, size, height, yaw_deg } => {
-            finite(&format!("{at}.center"), center[0])?;
-            finite(&format!("{at}.center"), center[1])?;
-            positive(&format!("{at}.size"), size[0])?;
-            positive(&format!("{at}.size"), size[1])?;
-            positive(&format!("{at}.height"), height)?;
-            finite(&format!("{at}.yaw_deg"), yaw_deg)?;
-        }
-        Primitive::Stairs {
-            start,
-            width,
-            steps,
-            step_depth,
-            step_height,
-            landing_depth,
-            yaw_deg,
-        } => {
-            finite(&format!("{at}.start"), start[0])?;
-            finite(&format!("{at}.start"), start[1])?;
-            positive(&format!("{at}.width"), width)?;
-            if steps == 0 {
-                return Err((format!("{at}.steps"), "must be at least 1".into()));
-            }
-            positive(&format!("{at}.step_depth"), step_depth)?;
-            positive(&format!("{at}.step_height"), step_height)?;
-            non_negative(&format!("{at}.landing_depth"), landing_depth)?;
-            finite(&format!("{at}.yaw_deg"), yaw_deg)?;
-        }
-        Primitive::Pole { center, radius, height } => {
-            finite(&format!("{at}.center"), center[0])?;
-            finite(&format!("{at}.center"), center[1])?;
-            positive(&format!("{at}.radius"), radius)?;
-            positive(&format!("{at}.height"), height)?;
-        }
-    }
     Ok(())
 }
 

@@ -6,13 +6,14 @@
 //! half-open cell square, i.e. the maximum of the ground plane (z = 0) and the top of every
 //! primitive whose footprint overlaps the cell in a set of positive area. This is
 //! conservative for a planner (an edge of a box claims every cell it cuts) and is computed
-//! exactly, not by sampling:
+//! exactly, not by sampling, from the [`Solid`]s each primitive is made of (this module
+//! knows those shapes, not the primitive kinds):
 //!
-//! - boxes and stair blocks (flat tops): a separating-axis test of the (rotated) footprint
-//!   rectangle against the cell square;
-//! - poles: the distance from the axis to the cell square against the radius;
-//! - ramps (linear tops): the cell square is clipped to the ramp's footprint in the ramp's
-//!   frame; the highest point is at a vertex of the clipped polygon.
+//! - boxes (`box` primitives, stair steps; flat tops): a separating-axis test of the (rotated)
+//!   footprint rectangle against the cell square;
+//! - cylinders (poles): the distance from the axis to the cell square against the radius;
+//! - wedges (ramps; linear tops): the cell square is clipped to the wedge's footprint in
+//!   its frame; the highest point is at a vertex of the clipped polygon.
 //!
 //! Overlaps thinner than [`OVERLAP_EPS_M`] are ignored, so a footprint edge that lies on a
 //! cell boundary (up to rounding of a rotation) does not bleed into the neighbouring cell.
@@ -21,7 +22,7 @@
 //! cost is the sum of the primitives' footprint areas in cells, not cells × primitives.
 
 use super::heightmap::{HeightMap, HeightMapError};
-use crate::scenario::terrain::Primitive;
+use crate::scenario::terrain::{Primitive, Solid};
 
 /// Overlaps between a footprint and a cell thinner than this are ignored (m): rounding
 /// noise from rotations, far below any physical size.
@@ -105,21 +106,23 @@ pub fn rasterise_into(primitives: &[Primitive], map: &mut HeightMap) -> Result<(
                 }
             }
         };
-        match *p {
-            Primitive::Box { .. } | Primitive::Stairs { .. } => {
-                for block in p.blocks() {
-                    let rect = Rect::new(block.center, block.half_size, block.yaw);
-                    visit(&|cell| rect.overlaps_cell(cell).then_some(block.height));
+        for solid in p.solids() {
+            match solid {
+                Solid::Box { center, half_size, height, yaw } => {
+                    let rect = Rect::new(center, half_size, yaw);
+                    visit(&|cell| rect.overlaps_cell(cell).then_some(height));
                 }
-            }
-            Primitive::Ramp { center, size, height, yaw_deg } => {
-                let rect = Rect::new(center, [size[0] / 2.0, size[1] / 2.0], yaw_deg.to_radians());
-                visit(&|cell| {
-                    rect.max_local_x_in_cell(cell).map(|lx| height * (lx / size[0] + 0.5))
-                });
-            }
-            Primitive::Pole { center, radius, height } => {
-                visit(&|cell| disc_overlaps_cell(center, radius, cell).then_some(height));
+                Solid::Wedge { center, half_size, height, yaw } => {
+                    let rect = Rect::new(center, half_size, yaw);
+                    // The rise over the whole run, 2·half_size[0] (exact in binary).
+                    let run = 2.0 * half_size[0];
+                    visit(&|cell| {
+                        rect.max_local_x_in_cell(cell).map(|lx| height * (lx / run + 0.5))
+                    });
+                }
+                Solid::Cylinder { center, radius, height } => {
+                    visit(&|cell| disc_overlaps_cell(center, radius, cell).then_some(height));
+                }
             }
         }
     }
@@ -128,24 +131,11 @@ pub fn rasterise_into(primitives: &[Primitive], map: &mut HeightMap) -> Result<(
 }
 
 fn check_primitive(index: usize, p: &Primitive) -> Result<(), RasteriseError> {
-    let ok = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    let nonneg = |v: &[f64]| v.iter().all(|x| x.is_finite() && *x >= 0.0);
-    let valid = match *p {
-        Primitive::Box { center, size, height, yaw_deg }
-        | Primitive::Ramp { center, size, height, yaw_deg } => {
-            ok(&[center[0], center[1], height, yaw_deg]) && nonneg(&size)
-        }
-        Primitive::Stairs {
-            start, width, step_depth, step_height, landing_depth, yaw_deg, ..
-        } => {
-            ok(&[start[0], start[1], step_height, yaw_deg])
-                && nonneg(&[width, step_depth, landing_depth])
-        }
-        Primitive::Pole { center, radius, height } => {
-            ok(&[center[0], center[1], height]) && nonneg(&[radius])
-        }
-    };
-    if valid { Ok(()) } else { Err(RasteriseError::BadPrimitive { index, kind: p.kind() }) }
+    if p.well_formed() {
+        Ok(())
+    } else {
+        Err(RasteriseError::BadPrimitive { index, kind: p.kind() })
+    }
 }
 
 /// The index ranges of cells that the bounds `[x_min, y_min, x_max, y_max]` touch.
@@ -268,13 +258,19 @@ fn disc_overlaps_cell(center: [f64; 2], radius: f64, cell: [f64; 4]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scenario::terrain::{Block, Pole, Ramp, Stairs};
 
     const RES: f64 = 0.025;
 
     #[test]
     fn axis_aligned_box_on_cell_boundaries_claims_exactly_its_cells() {
         // Box from x = 0.5 to 1.0 and y = -0.25 to 0.25: edges on cell boundaries.
-        let b = Primitive::Box { center: [0.75, 0.0], size: [0.5, 0.5], height: 0.2, yaw_deg: 0.0 };
+        let b = Primitive::Box(Block {
+            center: [0.75, 0.0],
+            size: [0.5, 0.5],
+            height: 0.2,
+            yaw_deg: 0.0,
+        });
         let m = rasterise(&[b], [0.0, -1.0], [2.0, 2.0], RES).unwrap();
         assert_eq!(m.dims(), (80, 80));
         // Cells 20..40 in x, 30..50 in y are on the box; their neighbours are ground.
@@ -289,8 +285,12 @@ mod tests {
     #[test]
     fn box_edge_inside_a_cell_raises_the_whole_cell() {
         // Box from x = 0.51 (inside cell 20 = [0.5, 0.525)).
-        let b =
-            Primitive::Box { center: [0.755, 0.0], size: [0.49, 0.5], height: 0.2, yaw_deg: 0.0 };
+        let b = Primitive::Box(Block {
+            center: [0.755, 0.0],
+            size: [0.49, 0.5],
+            height: 0.2,
+            yaw_deg: 0.0,
+        });
         let m = rasterise(&[b], [0.0, -1.0], [2.0, 2.0], RES).unwrap();
         assert_eq!(m.get(19, 40), Some(0.0));
         assert_eq!(m.get(20, 40), Some(0.2));
@@ -299,7 +299,12 @@ mod tests {
     #[test]
     fn ramp_cell_holds_its_highest_point() {
         // Ramp from x = 0 (h 0) to x = 2 (h 0.2), axis-aligned: slope 0.1.
-        let r = Primitive::Ramp { center: [1.0, 0.0], size: [2.0, 1.0], height: 0.2, yaw_deg: 0.0 };
+        let r = Primitive::Ramp(Ramp {
+            center: [1.0, 0.0],
+            size: [2.0, 1.0],
+            height: 0.2,
+            yaw_deg: 0.0,
+        });
         let m = rasterise(&[r], [0.0, -1.0], [3.0, 2.0], RES).unwrap();
         // Cell i covers [i·0.025, (i+1)·0.025): max at its right edge, 0.1·(i+1)·0.025.
         for i in [0usize, 7, 79] {
@@ -312,7 +317,7 @@ mod tests {
     #[test]
     fn pole_is_a_disc_of_cells() {
         // Pole of radius 0.05 centred on a cell corner: exactly the 4 x 4 cells around.
-        let p = Primitive::Pole { center: [0.5, 0.5], radius: 0.05, height: 0.4 };
+        let p = Primitive::Pole(Pole { center: [0.5, 0.5], radius: 0.05, height: 0.4 });
         let m = rasterise(&[p], [0.0, 0.0], [1.0, 1.0], RES).unwrap();
         let raised: Vec<(usize, usize)> = (0..40)
             .flat_map(|j| (0..40).map(move |i| (i, j)))
@@ -332,9 +337,19 @@ mod tests {
     #[test]
     fn rotated_primitives_match_dense_sampling() {
         let ps = [
-            Primitive::Box { center: [0.7, 0.6], size: [0.6, 0.3], height: 0.15, yaw_deg: 27.0 },
-            Primitive::Ramp { center: [1.6, 1.2], size: [1.0, 0.6], height: 0.3, yaw_deg: -40.0 },
-            Primitive::Stairs {
+            Primitive::Box(Block {
+                center: [0.7, 0.6],
+                size: [0.6, 0.3],
+                height: 0.15,
+                yaw_deg: 27.0,
+            }),
+            Primitive::Ramp(Ramp {
+                center: [1.6, 1.2],
+                size: [1.0, 0.6],
+                height: 0.3,
+                yaw_deg: -40.0,
+            }),
+            Primitive::Stairs(Stairs {
                 start: [0.3, 1.4],
                 width: 0.5,
                 steps: 3,
@@ -342,8 +357,8 @@ mod tests {
                 step_height: 0.1,
                 landing_depth: 0.1,
                 yaw_deg: 100.0,
-            },
-            Primitive::Pole { center: [1.5, 0.3], radius: 0.07, height: 0.5 },
+            }),
+            Primitive::Pole(Pole { center: [1.5, 0.3], radius: 0.07, height: 0.5 }),
         ];
         let m = rasterise(&ps, [0.0, 0.0], [2.5, 2.5], RES).unwrap();
         let mut raised = 0;
@@ -377,8 +392,12 @@ mod tests {
     #[test]
     fn unknown_cells_become_known_under_primitives() {
         let mut m = HeightMap::unknown([0.0, 0.0], RES, 10, 10).unwrap();
-        let b =
-            Primitive::Box { center: [0.05, 0.05], size: [0.05, 0.05], height: 0.1, yaw_deg: 0.0 };
+        let b = Primitive::Box(Block {
+            center: [0.05, 0.05],
+            size: [0.05, 0.05],
+            height: 0.1,
+            yaw_deg: 0.0,
+        });
         rasterise_into(&[b], &mut m).unwrap();
         assert_eq!(m.get(1, 1), Some(0.1));
         assert_eq!(m.get(5, 5), None);
@@ -386,8 +405,12 @@ mod tests {
 
     #[test]
     fn bad_input_is_rejected() {
-        let b =
-            Primitive::Box { center: [f64::NAN, 0.0], size: [1.0, 1.0], height: 0.1, yaw_deg: 0.0 };
+        let b = Primitive::Box(Block {
+            center: [f64::NAN, 0.0],
+            size: [1.0, 1.0],
+            height: 0.1,
+            yaw_deg: 0.0,
+        });
         assert_eq!(
             rasterise(&[b], [0.0, 0.0], [1.0, 1.0], RES),
             Err(RasteriseError::BadPrimitive { index: 0, kind: "box" })

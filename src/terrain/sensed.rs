@@ -403,7 +403,7 @@ pub fn agreement(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scenario::terrain::Primitive;
+    use crate::scenario::terrain::{Block, Pole, Primitive, Ramp, Solid, Stairs};
     use crate::terrain::rasterise::rasterise;
 
     const RES: f64 = 0.025;
@@ -480,30 +480,17 @@ mod tests {
         fn new(ps: &[Primitive]) -> Self {
             let mut solids = Vec::new();
             let mut poles = Vec::new();
-            for p in ps {
-                match *p {
-                    Primitive::Box { .. } | Primitive::Stairs { .. } => {
-                        for b in p.blocks() {
-                            solids.push(Polytope::prism(
-                                b.center,
-                                b.half_size,
-                                b.yaw,
-                                b.height,
-                                0.0,
-                            ));
-                        }
+            for solid in ps.iter().flat_map(Primitive::solids) {
+                match solid {
+                    Solid::Box { center, half_size, height, yaw } => {
+                        solids.push(Polytope::prism(center, half_size, yaw, height, 0.0));
                     }
-                    Primitive::Ramp { center, size, height, yaw_deg } => {
+                    Solid::Wedge { center, half_size, height, yaw } => {
                         // Top z = height·(lx/L + 1/2): h0 = height/2 at the centre.
-                        solids.push(Polytope::prism(
-                            center,
-                            [size[0] / 2.0, size[1] / 2.0],
-                            yaw_deg.to_radians(),
-                            height / 2.0,
-                            height / size[0],
-                        ));
+                        let slope = height / (2.0 * half_size[0]);
+                        solids.push(Polytope::prism(center, half_size, yaw, height / 2.0, slope));
                     }
-                    Primitive::Pole { center, radius, height } => {
+                    Solid::Cylinder { center, radius, height } => {
                         poles.push((center, radius, height))
                     }
                 }
@@ -568,12 +555,27 @@ mod tests {
 
     fn scene() -> Vec<Primitive> {
         vec![
-            Primitive::Box { center: [1.5, 0.6], size: [0.6, 0.8], height: 0.2, yaw_deg: 0.0 },
-            Primitive::Box { center: [-0.2, -1.6], size: [0.7, 0.4], height: 0.12, yaw_deg: 25.0 },
-            Primitive::Ramp { center: [-1.6, 0.3], size: [1.5, 1.0], height: 0.2, yaw_deg: 30.0 },
-            Primitive::Pole { center: [0.8, -1.0], radius: 0.05, height: 0.6 },
-            Primitive::Pole { center: [-0.7, 1.2], radius: 0.1, height: 0.15 },
-            Primitive::Stairs {
+            Primitive::Box(Block {
+                center: [1.5, 0.6],
+                size: [0.6, 0.8],
+                height: 0.2,
+                yaw_deg: 0.0,
+            }),
+            Primitive::Box(Block {
+                center: [-0.2, -1.6],
+                size: [0.7, 0.4],
+                height: 0.12,
+                yaw_deg: 25.0,
+            }),
+            Primitive::Ramp(Ramp {
+                center: [-1.6, 0.3],
+                size: [1.5, 1.0],
+                height: 0.2,
+                yaw_deg: 30.0,
+            }),
+            Primitive::Pole(Pole { center: [0.8, -1.0], radius: 0.05, height: 0.6 }),
+            Primitive::Pole(Pole { center: [-0.7, 1.2], radius: 0.1, height: 0.15 }),
+            Primitive::Stairs(Stairs {
                 start: [0.3, 1.5],
                 width: 0.8,
                 steps: 3,
@@ -581,7 +583,7 @@ mod tests {
                 step_height: 0.15,
                 landing_depth: 0.4,
                 yaw_deg: 80.0,
-            },
+            }),
         ]
     }
 

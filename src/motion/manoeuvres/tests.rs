@@ -11,7 +11,7 @@ use crate::params::Params;
 use crate::path::{EdgeLabel, ManoeuvreKind};
 use crate::planner::*;
 use crate::robot::{Leg, RobotDescription};
-use crate::scenario::terrain::Primitive;
+use crate::scenario::terrain::{Block, Primitive, Stairs};
 use crate::search::{Cost, SearchGraph, SearchParams, Termination, arastar, astar};
 use crate::terrain::rasterise;
 
@@ -21,7 +21,8 @@ fn robot() -> RobotDescription {
 
 /// A 4 m × 2 m map from (−1, −1) with a platform of `height` from x = 1 m on.
 fn platform_maps(height: f64) -> CostMaps {
-    let prims = [Primitive::Box { center: [2.0, 0.0], size: [2.0, 2.0], height, yaw_deg: 0.0 }];
+    let prims =
+        [Primitive::Box(Block { center: [2.0, 0.0], size: [2.0, 2.0], height, yaw_deg: 0.0 })];
     let m = rasterise(&prims, [-1.0, -1.0], [4.0, 2.0], 0.025).expect("map");
     CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps")
 }
@@ -509,11 +510,8 @@ fn every_wheel_move_offered_past_a_block_edge_is_one_the_generator_expands() {
     // passes 3.7 cm over the block's edge, within the legs' 4 cm clearance: the
     // generator rejected the planned path ("wheel_move: at 33 % of the segment").
     let robot = robot();
-    let block = |center: [f64; 2], size: [f64; 2], height: f64, yaw_deg: f64| Primitive::Box {
-        center,
-        size,
-        height,
-        yaw_deg,
+    let block = |center: [f64; 2], size: [f64; 2], height: f64, yaw_deg: f64| {
+        Primitive::Box(Block { center, size, height, yaw_deg })
     };
     let prims = [
         block([-0.57, 0.002], [1.14, 5.581], 0.229, 178.2),
@@ -562,10 +560,11 @@ fn steps_down_0_3_m_between_walls_with_the_descent_shift() {
     // reaches the floor beyond the untraversable band. Every drop of 0.24-0.30 m
     // answered "no path" after searching the whole map; with the descent shift (the
     // hip over the middle of the step first) the robot steps down head-on.
-    let wall =
-        |y: f64| Primitive::Box { center: [1.5, y], size: [6.0, 0.2], height: 1.0, yaw_deg: 0.0 };
+    let wall = |y: f64| {
+        Primitive::Box(Block { center: [1.5, y], size: [6.0, 0.2], height: 1.0, yaw_deg: 0.0 })
+    };
     let prims = [
-        Primitive::Box { center: [-0.25, 0.0], size: [2.5, 3.0], height: 0.3, yaw_deg: 0.0 },
+        Primitive::Box(Block { center: [-0.25, 0.0], size: [2.5, 3.0], height: 0.3, yaw_deg: 0.0 }),
         wall(0.75),
         wall(-0.75),
     ];
@@ -605,9 +604,14 @@ fn translated_step_failures_turn_away_only_steps_that_fail() {
     // down 0.3 m fail from stances that step down 0.2 m: without the terrain's print
     // in the key, the first would turn the second away.
     let prims = [
-        Primitive::Box { center: [-0.25, -1.5], size: [2.5, 3.0], height: 0.3, yaw_deg: 0.0 },
-        Primitive::Box { center: [-0.25, 1.5], size: [2.5, 3.0], height: 0.2, yaw_deg: 0.0 },
-        Primitive::Box { center: [2.6, 0.0], size: [0.4, 6.0], height: 0.2, yaw_deg: 0.0 },
+        Primitive::Box(Block {
+            center: [-0.25, -1.5],
+            size: [2.5, 3.0],
+            height: 0.3,
+            yaw_deg: 0.0,
+        }),
+        Primitive::Box(Block { center: [-0.25, 1.5], size: [2.5, 3.0], height: 0.2, yaw_deg: 0.0 }),
+        Primitive::Box(Block { center: [2.6, 0.0], size: [0.4, 6.0], height: 0.2, yaw_deg: 0.0 }),
     ];
     let m = rasterise(&prims, [-1.5, -3.0], [6.0, 6.0], 0.025).expect("map");
     let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
@@ -658,7 +662,7 @@ fn descends_a_flight_with_the_descent_shift_mid_flight() {
     // ground) after a mid-flight shift tipped the robot over; with the executor's
     // stance compliance that shift is safe, and without it a front foot on a middle
     // tread cannot step down: this flight had no path.
-    let stairs = Primitive::Stairs {
+    let stairs = Primitive::Stairs(Stairs {
         start: [0.0, 0.0],
         width: 1.8,
         steps: 3,
@@ -666,7 +670,7 @@ fn descends_a_flight_with_the_descent_shift_mid_flight() {
         step_height: 0.2,
         landing_depth: 3.0,
         yaw_deg: 0.0,
-    };
+    });
     let m = rasterise(&[stairs], [-2.0, -1.5], [6.05, 3.0], 0.025).expect("map");
     let params = Params {
         step_model: crate::params::StepModel::Stairs,
@@ -718,8 +722,12 @@ fn a_thin_wall_a_step_cannot_cross_makes_the_bound_infinite() {
     // components' heights do not tell it apart; what does is that every cell a step
     // passes stays within 0.3 m of the foot's ground (criterion 3).
     let wall = |h: f64| {
-        let prims =
-            [Primitive::Box { center: [1.5, 0.0], size: [0.1, 2.4], height: h, yaw_deg: 0.0 }];
+        let prims = [Primitive::Box(Block {
+            center: [1.5, 0.0],
+            size: [0.1, 2.4],
+            height: h,
+            yaw_deg: 0.0,
+        })];
         let m = rasterise(&prims, [-1.0, -1.0], [4.0, 2.0], 0.025).expect("map");
         CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps")
     };
@@ -803,8 +811,12 @@ fn a_step_longer_than_the_legs_reach_is_no_step_edge() {
     // floors are 0 m high: a single "step" floor to floor would cost only k7 · L.
     // No step is longer than a leg's range of offsets (1 m), so each foot pays the
     // step up and the step down, each as in `step_bound_is_one_platform_step_per_foot`.
-    let prims =
-        [Primitive::Box { center: [1.9, 0.0], size: [1.5, 2.0], height: 0.25, yaw_deg: 0.0 }];
+    let prims = [Primitive::Box(Block {
+        center: [1.9, 0.0],
+        size: [1.5, 2.0],
+        height: 0.25,
+        yaw_deg: 0.0,
+    })];
     let m = rasterise(&prims, [-1.0, -1.0], [5.0, 2.0], 0.025).expect("map");
     let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
     let goal = state_on(&maps, 3.5, 0.0, 0.0);
@@ -982,11 +994,8 @@ proptest::proptest! {
 fn random_maps(boxes: &[(f64, f64, f64, f64, f64, f64)]) -> CostMaps {
     let prims: Vec<Primitive> = boxes
         .iter()
-        .map(|&(x, y, w, d, h, yaw)| Primitive::Box {
-            center: [x, y],
-            size: [w, d],
-            height: h,
-            yaw_deg: yaw,
+        .map(|&(x, y, w, d, h, yaw)| {
+            Primitive::Box(Block { center: [x, y], size: [w, d], height: h, yaw_deg: yaw })
         })
         .collect();
     let m = rasterise(&prims, [-0.8, -0.8], [3.2, 1.6], 0.025).expect("map");
@@ -1091,7 +1100,7 @@ fn a_flight_longer_than_the_robot_has_a_path() {
     // 0.8 m): with a rear foot short of a riser unable to roll up to it, and no base
     // shift past the front feet's neutral while they stand on a tread, flights of
     // four or more steps were searched exhaustively without a path.
-    let prims = [Primitive::Stairs {
+    let prims = [Primitive::Stairs(Stairs {
         start: [0.0, 0.0],
         width: 1.8,
         steps: 6,
@@ -1099,7 +1108,7 @@ fn a_flight_longer_than_the_robot_has_a_path() {
         step_height: 0.17,
         landing_depth: 1.5,
         yaw_deg: 0.0,
-    }];
+    })];
     let m = rasterise(&prims, [-1.6, -1.2], [5.0, 2.4], 0.025).expect("map");
     let params = Params {
         step_model: crate::params::StepModel::Stairs,
@@ -1128,7 +1137,7 @@ fn a_flight_longer_than_the_robot_has_a_path() {
 fn climbs_a_small_platform_and_ara_ends_at_the_astar_cost() {
     // 3.2 m × 1.6 m: small enough for an exhaustive search.
     let prims =
-        [Primitive::Box { center: [1.8, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 }];
+        [Primitive::Box(Block { center: [1.8, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 })];
     let m = rasterise(&prims, [-0.8, -0.8], [3.2, 1.6], 0.025).expect("map");
     let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("maps");
     let (start, goal) = (state_on(&maps, 0.0, 0.0, 0.0), state_on(&maps, 1.5, 0.0, 0.0));

@@ -711,13 +711,24 @@ mod tests {
     use crate::planner::lattice::Neighbourhood;
     use crate::robot::RobotDescription;
     use crate::scenario::Primitive;
+    use crate::scenario::terrain::Block;
     use crate::terrain::rasterise;
 
     fn setup() -> (CostMaps, Lattice, DrivingConfig) {
         let robot = RobotDescription::reference();
         let prims = [
-            Primitive::Box { center: [1.8, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 },
-            Primitive::Box { center: [0.5, 0.5], size: [0.2, 0.2], height: 0.1, yaw_deg: 20.0 },
+            Primitive::Box(Block {
+                center: [1.8, 0.0],
+                size: [2.0, 2.0],
+                height: 0.2,
+                yaw_deg: 0.0,
+            }),
+            Primitive::Box(Block {
+                center: [0.5, 0.5],
+                size: [0.2, 0.2],
+                height: 0.1,
+                yaw_deg: 20.0,
+            }),
         ];
         let m = rasterise(&prims, [-0.8, -0.8], [3.2, 1.6], 0.025).expect("map");
         let maps = CostMaps::build(&m, &robot, &Params::default()).expect("maps");

@@ -519,6 +519,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::params::Params;
     use crate::scenario::Primitive;
+    use crate::scenario::terrain::Block;
     use crate::terrain::rasterise;
 
     /// The paper's standing rule (0.45 m legs, 70 % of the slope) with the front feet at
@@ -552,7 +553,7 @@ pub(crate) mod tests {
     }
 
     fn wall(center: [f64; 2], size: [f64; 2]) -> Primitive {
-        Primitive::Box { center, size, height: 1.2, yaw_deg: 0.0 }
+        Primitive::Box(Block { center, size, height: 1.2, yaw_deg: 0.0 })
     }
 
     fn goal_reachable(r: &BaseRegions, l: &Lattice, p: [f64; 2]) -> bool {
@@ -566,10 +567,30 @@ pub(crate) mod tests {
         // edge: the cells the quick pass admits whole are those every orientation's
         // probes admit, cell by cell and orientation by orientation.
         let prims = [
-            Primitive::Box { center: [2.0, 0.0], size: [1.0, 4.0], height: 0.3, yaw_deg: 0.0 },
-            Primitive::Box { center: [0.5, 1.0], size: [0.3, 0.4], height: 0.5, yaw_deg: 30.0 },
-            Primitive::Box { center: [4.0, -1.2], size: [0.2, 1.6], height: 1.2, yaw_deg: 0.0 },
-            Primitive::Box { center: [4.0, 1.2], size: [0.2, 1.6], height: 1.2, yaw_deg: 0.0 },
+            Primitive::Box(Block {
+                center: [2.0, 0.0],
+                size: [1.0, 4.0],
+                height: 0.3,
+                yaw_deg: 0.0,
+            }),
+            Primitive::Box(Block {
+                center: [0.5, 1.0],
+                size: [0.3, 0.4],
+                height: 0.5,
+                yaw_deg: 30.0,
+            }),
+            Primitive::Box(Block {
+                center: [4.0, -1.2],
+                size: [0.2, 1.6],
+                height: 1.2,
+                yaw_deg: 0.0,
+            }),
+            Primitive::Box(Block {
+                center: [4.0, 1.2],
+                size: [0.2, 1.6],
+                height: 1.2,
+                yaw_deg: 0.0,
+            }),
         ];
         let robot = RobotDescription::reference();
         let mut hm = rasterise(&prims, [-1.0, -2.0], [6.0, 4.0], 0.025).unwrap();
@@ -608,11 +629,8 @@ pub(crate) mod tests {
     /// doorway `gap` wide about y = 0.
     pub(crate) fn doorway(gap: f64, thickness: f64, height: f64) -> [Primitive; 2] {
         let w = (4.0 - gap) / 2.0;
-        let side = |y: f64| Primitive::Box {
-            center: [2.0, y],
-            size: [thickness, w],
-            height,
-            yaw_deg: 0.0,
+        let side = |y: f64| {
+            Primitive::Box(Block { center: [2.0, y], size: [thickness, w], height, yaw_deg: 0.0 })
         };
         [side(gap / 2.0 + w / 2.0), side(-gap / 2.0 - w / 2.0)]
     }
@@ -639,8 +657,18 @@ pub(crate) mod tests {
         // this test once kept open, is closed: no state's base clears it, and the step
         // bound already refused it, 0.2 m above the largest step.)
         let prims = [
-            Primitive::Box { center: [2.0, 0.0], size: [1.0, 4.0], height: 0.3, yaw_deg: 0.0 },
-            Primitive::Box { center: [3.6, 0.0], size: [0.1, 4.0], height: 0.4, yaw_deg: 0.0 },
+            Primitive::Box(Block {
+                center: [2.0, 0.0],
+                size: [1.0, 4.0],
+                height: 0.3,
+                yaw_deg: 0.0,
+            }),
+            Primitive::Box(Block {
+                center: [3.6, 0.0],
+                size: [0.1, 4.0],
+                height: 0.4,
+                yaw_deg: 0.0,
+            }),
         ];
         let (r, l) = regions(&prims, [4.5, 0.0]);
         assert!(goal_reachable(&r, &l, [0.0, 0.0]));
@@ -730,10 +758,30 @@ pub(crate) mod tests {
     fn odd_terrain() -> (CostMaps, RobotDescription, Lattice) {
         // Walls, a tall block and a low platform at odd angles, near the map's edges too.
         let prims = [
-            Primitive::Box { center: [2.0, 0.3], size: [0.2, 2.5], height: 1.2, yaw_deg: 17.0 },
-            Primitive::Box { center: [3.5, -1.5], size: [1.5, 0.8], height: 0.9, yaw_deg: 40.0 },
-            Primitive::Box { center: [0.5, 1.7], size: [0.6, 0.6], height: 0.3, yaw_deg: -25.0 },
-            Primitive::Box { center: [4.8, 0.0], size: [0.3, 3.0], height: 0.75, yaw_deg: 5.0 },
+            Primitive::Box(Block {
+                center: [2.0, 0.3],
+                size: [0.2, 2.5],
+                height: 1.2,
+                yaw_deg: 17.0,
+            }),
+            Primitive::Box(Block {
+                center: [3.5, -1.5],
+                size: [1.5, 0.8],
+                height: 0.9,
+                yaw_deg: 40.0,
+            }),
+            Primitive::Box(Block {
+                center: [0.5, 1.7],
+                size: [0.6, 0.6],
+                height: 0.3,
+                yaw_deg: -25.0,
+            }),
+            Primitive::Box(Block {
+                center: [4.8, 0.0],
+                size: [0.3, 3.0],
+                height: 0.75,
+                yaw_deg: 5.0,
+            }),
             // A closed room of 1.2 m walls.
             wall([0.2, -0.3], [2.2, 0.2]),
             wall([0.2, -1.9], [2.2, 0.2]),

@@ -622,12 +622,16 @@ mod tests {
         // are those of the search without. Steps of every leg, from stances before the
         // paper's 0.2 m platform and on it, onto footholds on the floor, at the edge and
         // on top, forward and back; both candidate sets.
-        use crate::scenario::terrain::Primitive;
+        use crate::scenario::terrain::{Block, Primitive};
         use crate::terrain::rasterise::rasterise;
         let robot = RobotDescription::reference();
         let params = Params::default();
-        let prims =
-            [Primitive::Box { center: [2.0, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 }];
+        let prims = [Primitive::Box(Block {
+            center: [2.0, 0.0],
+            size: [2.0, 2.0],
+            height: 0.2,
+            yaw_deg: 0.0,
+        })];
         let map = rasterise(&prims, [-1.0, -1.0], [4.0, 2.0], 0.025).expect("map");
         let maps = CostMaps::build(&map, &robot, &params).expect("cost maps");
         let options = MotionOptions::from_params(&params);
