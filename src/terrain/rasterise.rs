@@ -22,7 +22,7 @@
 //! cost is the sum of the primitives' footprint areas in cells, not cells × primitives.
 
 use super::heightmap::{HeightMap, HeightMapError};
-use crate::scenario::terrain::{Primitive, Solid};
+use crate::scenario::terrain::{Primitive, Solid, terrain_height};
 
 /// Overlaps between a footprint and a cell thinner than this are ignored (m): rounding
 /// noise from rotations, far below any physical size.
@@ -255,6 +255,35 @@ fn disc_overlaps_cell(center: [f64; 2], radius: f64, cell: [f64; 4]) -> bool {
     r > 0.0 && dx * dx + dy * dy < r * r
 }
 
+/// Lowest and highest terrain surface over cell (i, j) of `map`, sampled on an 11 × 11
+/// grid that includes points a hair inside each edge. The minimum, with the rasterised value
+/// (the exact highest surface), bounds what a sensor may legitimately report for the cell;
+/// the maximum is a sampled lower bound of that rasterised value.
+pub fn sampled_height_range(
+    primitives: &[Primitive],
+    map: &HeightMap,
+    i: usize,
+    j: usize,
+) -> [f64; 2] {
+    let o = map.origin();
+    let res = map.resolution();
+    let fr = |k: usize| match k {
+        0 => 1e-7,
+        10 => 1.0 - 1e-7,
+        _ => k as f64 / 10.0,
+    };
+    let mut range = [f64::INFINITY, f64::NEG_INFINITY];
+    for a in 0..=10 {
+        for b in 0..=10 {
+            let x = o[0] + (i as f64 + fr(a)) * res;
+            let y = o[1] + (j as f64 + fr(b)) * res;
+            let h = terrain_height(primitives, x, y);
+            range = [range[0].min(h), range[1].max(h)];
+        }
+    }
+    range
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -365,7 +394,7 @@ mod tests {
         for j in 0..m.ny() {
             for i in 0..m.nx() {
                 let exact = m.get(i, j).unwrap();
-                let [_, sampled] = crate::terrain::sensed::sampled_height_range(&ps, &m, i, j);
+                let [_, sampled] = sampled_height_range(&ps, &m, i, j);
                 // Sampling can only miss a sliver: never above the exact value, and within
                 // a ramp's rise over a tenth of a cell diagonal of it for most cells.
                 assert!(sampled <= exact + 1e-9, "({i},{j}) sampled {sampled} > {exact}");

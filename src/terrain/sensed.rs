@@ -26,7 +26,8 @@
 //!   dropped (counted in [`ScanStats`]). Cells that no ray reaches stay unknown.
 
 use super::heightmap::{HeightMap, HeightMapError};
-use crate::scenario::terrain::{Primitive, terrain_height};
+use super::rasterise::sampled_height_range;
+use crate::scenario::terrain::Primitive;
 
 /// A ray's first intersection with the world.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -316,35 +317,6 @@ pub struct ScanStats {
     pub out_of_range: usize,
     /// Returns outside the map.
     pub outside_map: usize,
-}
-
-/// Lowest and highest terrain surface over cell (i, j) of `map`, sampled on an 11 × 11
-/// grid that includes points a hair inside each edge. The minimum, with the rasterised value
-/// (the exact highest surface), bounds what a sensor may legitimately report for the cell;
-/// the maximum is a sampled lower bound of that rasterised value.
-pub fn sampled_height_range(
-    primitives: &[Primitive],
-    map: &HeightMap,
-    i: usize,
-    j: usize,
-) -> [f64; 2] {
-    let o = map.origin();
-    let res = map.resolution();
-    let fr = |k: usize| match k {
-        0 => 1e-7,
-        10 => 1.0 - 1e-7,
-        _ => k as f64 / 10.0,
-    };
-    let mut range = [f64::INFINITY, f64::NEG_INFINITY];
-    for a in 0..=10 {
-        for b in 0..=10 {
-            let x = o[0] + (i as f64 + fr(a)) * res;
-            let y = o[1] + (j as f64 + fr(b)) * res;
-            let h = terrain_height(primitives, x, y);
-            range = [range[0].min(h), range[1].max(h)];
-        }
-    }
-    range
 }
 
 /// How a sensed map compares with the rasterised map of the same terrain and grid.

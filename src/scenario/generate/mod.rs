@@ -7,7 +7,7 @@
 //! from its seed alone. Every draw is checked here to parse as a
 //! [`Scenario`](super::Scenario) and to keep
 //! its map within [`MAX_MAP_M`]; whether the robot can stand at its start and goal needs
-//! the robot, so `jobs::generate` checks that (`jobs::plan::prepare`) and asks for the
+//! the robot, so `jobs::generate` checks that (`planner::prepare`) and asks for the
 //! next draw of the same stream ([`Draws::next_case`]) when it fails.
 //!
 //! **A class is a unit.** Each class is one file (`stairs.rs`, `step_down.rs`, ...)
