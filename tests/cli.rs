@@ -586,6 +586,14 @@ fn plan_json_prints_one_object_whatever_happens() {
     let stairs = common::root().join("scenarios/staircase.toml");
     let (code, v) = plan_json(&[stairs.to_str().unwrap(), "--time-limit", "0.001"]);
     assert_eq!((code, v["failure_kind"].as_str()), (Some(1), Some("planning_time_limit")), "{v}");
+    // The expansion budget before any path: reported as the time limit is, whatever the
+    // machine's speed; a budget of none is bad input.
+    let (code, v) = plan_json(&[stairs.to_str().unwrap(), "--max-expansions", "50"]);
+    assert_eq!((code, v["failure_kind"].as_str()), (Some(1), Some("planning_time_limit")), "{v}");
+    let said = v["failure"].as_str().unwrap_or_default();
+    assert!(said.contains("within the expansion budget of 50"), "{v}");
+    let (code, v) = plan_json(&[stairs.to_str().unwrap(), "--max-expansions", "0"]);
+    assert_eq!((code, v["failure_kind"].as_str()), (Some(2), Some("invalid_input")), "{v}");
     // Bad input, with and without `--detailed`: exit 2, `invalid_input` naming the file.
     let dir = common::temp_dir("cli_plan_json");
     let bad = dir.join("broken.toml");

@@ -308,7 +308,8 @@ fn expand_generated_up_and_over(dir: &str, seeds: &[u64], opts: &PlanOptions) {
     let robot = sim.robot().clone();
     let dir = common::temp_dir(dir);
     for &seed in seeds {
-        let (case, _) = checked_case(Class::UpAndOver, seed, &dir, &robot).expect("generated");
+        let (case, _) =
+            checked_case(Class::UpAndOver, seed, &dir, &robot, false).expect("generated");
         let s = case.scenario(&dir).expect("scenario");
         let p = planner::run(&s, sim.robot(), opts, &ALL).expect("plan");
         assert!(p.steps >= 8, "{}: {} steps planned", s.name, p.steps);

@@ -186,11 +186,24 @@ pub struct GenerateArgs {
     /// Only this class of course.
     #[arg(long, value_name = "CLASS", value_parser = class_parser())]
     pub class: Option<Class>,
+    /// How flights of stairs are written: as `stairs` primitives, or as stacked boxes, a
+    /// box per step (the same heights cell for cell, without the label).
+    #[arg(long, value_enum, default_value_t = StairsAsArg::Stairs)]
+    pub stairs_as: StairsAsArg,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]
     pub model: ModelArgs,
+}
+
+/// `generate --stairs-as` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum StairsAsArg {
+    /// A `stairs` primitive per flight.
+    Stairs,
+    /// A `box` primitive per step.
+    Boxes,
 }
 
 /// The arguments of `momaro urdf`.
@@ -355,6 +368,11 @@ pub struct PlannerArgs {
     /// `check` and `envelope`, so that their plans do not depend on the machine's speed).
     #[arg(long)]
     pub schedule_expansions: Option<u64>,
+    /// Expansion budget of each plan (replans included): the search stops after N
+    /// expansions, reported as the time limit is. With a time limit that never binds it
+    /// makes a plan, and a suite's verdicts, independent of the machine and its load.
+    #[arg(long, value_name = "N")]
+    pub max_expansions: Option<u64>,
     /// Orientation cost factor k12 (default: the scenario's, 2.0).
     #[arg(long, allow_negative_numbers = true)]
     pub k12: Option<f64>,
@@ -407,6 +425,7 @@ impl PlannerArgs {
             probe_epsilon: self.probe_epsilon,
             probe_guidance: !self.unguided_probe,
             schedule_expansions: self.schedule_expansions,
+            max_expansions: self.max_expansions,
             final_epsilon: self.final_epsilon,
             overrides: crate::planner::ParamOverrides {
                 k12: self.k12,

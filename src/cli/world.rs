@@ -113,8 +113,14 @@ pub fn costmap(args: CostmapArgs) -> anyhow::Result<bool> {
 /// # Errors
 /// Bad input, or a job that could not be carried out.
 pub fn generate(args: GenerateArgs) -> anyhow::Result<bool> {
-    let GenerateArgs { seed, count, out, class, json, model } = args;
-    let opts = jobs::generate::GenerateOptions { seed, count, out_dir: out, class };
+    let GenerateArgs { seed, count, out, class, stairs_as, json, model } = args;
+    let opts = jobs::generate::GenerateOptions {
+        seed,
+        count,
+        out_dir: out,
+        class,
+        stairs_as_boxes: stairs_as == StairsAsArg::Boxes,
+    };
     if count == 0 {
         // Before the model loads: bad input is reported as such even without it.
         return Err(anyhow::Error::new(BadInput(

@@ -259,8 +259,13 @@ impl<'a> ClosedLoop<'a> {
         let mut from_here = self.scenario.clone();
         from_here.start =
             planner::nearest_start(self.prep, &self.robot, truth, REPLAN_START_RADIUS_M);
-        let replan_opts =
-            PlanOptions { time_limit_s: self.opts.replan_time_limit_s, ..self.opts.plan.clone() };
+        // A replan's own time limit, unless the plans have an expansion budget: then the
+        // run's limit holds for it too, so that its outcome does not depend on the load.
+        let time_limit_s = match self.opts.plan.max_expansions {
+            Some(_) => self.opts.plan.time_limit_s,
+            None => self.opts.replan_time_limit_s,
+        };
+        let replan_opts = PlanOptions { time_limit_s, ..self.opts.plan.clone() };
         let result = self
             .prep
             .set_start(&from_here, &self.robot, from_here.start)

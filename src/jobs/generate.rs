@@ -28,6 +28,9 @@ pub struct GenerateOptions {
     pub out_dir: PathBuf,
     /// Only this class (default: the classes in turn).
     pub class: Option<Class>,
+    /// Write every flight of stairs as stacked boxes, a box per step
+    /// (`GeneratedCase::with_stairs_as_boxes`), instead of a `stairs` primitive.
+    pub stairs_as_boxes: bool,
 }
 
 /// Why generation failed.
@@ -110,7 +113,8 @@ pub struct GenerateSummary {
 }
 
 /// The first draw of `class` from `seed` that loads as a scenario at `dir` and passes
-/// the planner's start and goal check, with its text.
+/// the planner's start and goal check, with its text; with `stairs_as_boxes`, its flights
+/// written as boxes.
 ///
 /// # Errors
 /// [`GenerateJobError::Generate`] if the generator fails,
@@ -120,11 +124,13 @@ pub fn checked_case(
     seed: u64,
     dir: &Path,
     robot: &RobotDescription,
+    stairs_as_boxes: bool,
 ) -> Result<(GeneratedCase, String), GenerateJobError> {
     let mut draws = Draws::new(class, seed);
     let mut reason = String::new();
     for _ in 0..MAX_TRIES {
         let case = draws.next_case()?;
+        let case = if stairs_as_boxes { case.with_stairs_as_boxes() } else { case };
         let text = case.to_toml()?;
         let path = dir.join(case.file_name());
         match Scenario::parse(&text, &path) {
@@ -171,7 +177,7 @@ pub fn run(
     for i in 0..opts.count as u64 {
         let seed = opts.seed + i;
         let class = opts.class.unwrap_or_else(|| Class::of_case(i));
-        cases.push(checked_case(class, seed, &opts.out_dir, robot)?);
+        cases.push(checked_case(class, seed, &opts.out_dir, robot, opts.stairs_as_boxes)?);
     }
     std::fs::create_dir_all(&opts.out_dir)
         .map_err(|source| GenerateJobError::Io { path: opts.out_dir.clone(), source })?;

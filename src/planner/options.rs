@@ -61,7 +61,8 @@ pub struct PlanOptions {
     /// (`SearchParams::schedule_max_expansions`): the probe's path is then the answer
     /// on any machine. Default none.
     pub schedule_expansions: Option<u64>,
-    /// Cap on the whole search's expansions (`SearchParams::max_expansions`). Default none.
+    /// Expansion budget of the whole search (`SearchParams::max_expansions`): where it
+    /// stops the search without a path, the plan fails as at its time limit. Default none.
     pub max_expansions: Option<u64>,
     /// ARA* stops once a solution with this ε is found (default 1: the optimum). Equal
     /// to the initial ε, the first solution is taken: the same plan on any machine, where
@@ -216,6 +217,9 @@ pub(crate) fn check_options(opts: &PlanOptions) -> Result<Duration, PlanError> {
         && !(k.is_finite() && k >= 1.0)
     {
         return Err(bad("k12", format!("{k} must be at least 1")));
+    }
+    if opts.max_expansions == Some(0) {
+        return Err(bad("max_expansions", "0 must be at least 1"));
     }
     if let Some(e) = opts.final_epsilon
         && !(e.is_finite() && e >= 1.0 && e <= opts.initial_epsilon.unwrap_or(e))

@@ -351,6 +351,12 @@ fn search_prepared(
                 "none found within the time limit of {} s ({} expansions{})",
                 opts.time_limit_s, result.expansions, checks
             ),
+            Termination::ExpansionLimit => format!(
+                "none found within the expansion budget of {} ({:.1} s{})",
+                opts.max_expansions.unwrap_or(result.expansions),
+                result.elapsed.as_secs_f64(),
+                checks
+            ),
             t => format!("the search stopped ({})", termination_name(t)),
         };
         let reason = reason + &stairs_model_hint(scenario, prep.params.step_model);

@@ -48,6 +48,6 @@ pub fn generated(class: momaro::scenario::generate::Class, seed: u64) -> Scenari
     let robot = momaro::sim::Simulation::robot_only(&model()).expect("model").robot().clone();
     let dir = temp_dir(&format!("generated_{class:?}_{seed}"));
     let (case, _) =
-        momaro::jobs::generate::checked_case(class, seed, &dir, &robot).expect("generated");
+        momaro::jobs::generate::checked_case(class, seed, &dir, &robot, false).expect("generated");
     case.scenario(&dir).expect("scenario")
 }

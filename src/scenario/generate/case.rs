@@ -76,6 +76,31 @@ struct NamedModels {
 }
 
 impl GeneratedCase {
+    /// This case with every flight of stairs written as stacked boxes, a box per step
+    /// (`Primitive::as_boxes`): the same heights cell for cell, no `stairs` label. The
+    /// file name, class and description stay, so a labelled course and its box version
+    /// pair by name.
+    #[must_use]
+    pub fn with_stairs_as_boxes(mut self) -> Self {
+        self.terrain = self
+            .terrain
+            .into_iter()
+            .flat_map(|p| {
+                let boxes = p.primitive.as_boxes();
+                let n = boxes.len();
+                boxes.into_iter().enumerate().map(move |(k, primitive)| Placed {
+                    note: if n > 1 {
+                        format!("{}, step {} as a box", p.note, k + 1)
+                    } else {
+                        p.note.clone()
+                    },
+                    primitive,
+                })
+            })
+            .collect();
+        self
+    }
+
     /// The file name: `{class}_{seed:06}.toml`.
     pub fn file_name(&self) -> String {
         format!("{}.toml", self.name)

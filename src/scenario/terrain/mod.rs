@@ -79,6 +79,13 @@ pub(crate) trait PrimitiveKind {
     fn flight_steps(&self) -> Option<u32> {
         None
     }
+
+    /// The same terrain written as boxes, where the kind is made of boxes alone and is
+    /// not one: the same solids, so the same heights cell for cell and the same world
+    /// (`momaro generate --stairs-as boxes`). `None` for the other kinds.
+    fn as_blocks(&self) -> Option<Vec<Block>> {
+        None
+    }
 }
 
 /// A solid standing on the ground plane (it reaches down to z = 0), in world
@@ -175,6 +182,15 @@ impl Primitive {
     /// The number of steps of a flight of stairs; `None` for the other kinds.
     pub fn flight_steps(&self) -> Option<u32> {
         self.unit().flight_steps()
+    }
+
+    /// The primitive written as boxes where it is made of boxes but is not one (a flight
+    /// of stairs: a box per step), with the same solids; itself otherwise.
+    pub fn as_boxes(&self) -> Vec<Primitive> {
+        match self.unit().as_blocks() {
+            Some(blocks) => blocks.into_iter().map(Primitive::Box).collect(),
+            None => vec![self.clone()],
+        }
     }
 }
 

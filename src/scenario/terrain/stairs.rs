@@ -4,7 +4,7 @@
 //! simulated world.
 
 use super::{
-    PrimitiveKind, Solid, all_finite, all_non_negative, rotated_bounds, to_local, to_world,
+    Block, PrimitiveKind, Solid, all_finite, all_non_negative, rotated_bounds, to_local, to_world,
 };
 use crate::scenario::field::{FieldError, finite, non_negative, positive};
 use serde::{Deserialize, Serialize};
@@ -34,6 +34,11 @@ pub struct Stairs {
 }
 
 impl Stairs {
+    /// The depth of step `k`'s box (1-based): the step's, the last one's with the landing.
+    fn tread_of(&self, k: u32) -> f64 {
+        if k == self.steps { self.step_depth + self.landing_depth } else { self.step_depth }
+    }
+
     /// Length of the flight along its local x, the landing included, m.
     fn run(&self) -> f64 {
         f64::from(self.steps) * self.step_depth + self.landing_depth
@@ -91,11 +96,7 @@ impl PrimitiveKind for Stairs {
         let yaw = self.yaw_deg.to_radians();
         (1..=self.steps)
             .map(|k| {
-                let depth = if k == self.steps {
-                    self.step_depth + self.landing_depth
-                } else {
-                    self.step_depth
-                };
+                let depth = self.tread_of(k);
                 let lx = f64::from(k - 1) * self.step_depth + depth / 2.0;
                 Solid::Box {
                     center: to_world(self.start, yaw, lx, 0.0),
@@ -110,11 +111,32 @@ impl PrimitiveKind for Stairs {
     fn flight_steps(&self) -> Option<u32> {
         Some(self.steps)
     }
+
+    /// A box per step from the ground to its tread, the last with the landing: the
+    /// flight's own solids ([`Self::solids`]), written as `box` primitives (the yaw kept in
+    /// degrees as given, so the boxes' solids are the flight's bit for bit).
+    fn as_blocks(&self) -> Option<Vec<Block>> {
+        let yaw = self.yaw_deg.to_radians();
+        let blocks = (1..=self.steps)
+            .map(|k| {
+                let depth = self.tread_of(k);
+                let lx = f64::from(k - 1) * self.step_depth + depth / 2.0;
+                Block {
+                    center: to_world(self.start, yaw, lx, 0.0),
+                    size: [depth, self.width],
+                    height: f64::from(k) * self.step_height,
+                    yaw_deg: self.yaw_deg,
+                }
+            })
+            .collect();
+        Some(blocks)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scenario::terrain::Primitive;
 
     const FLIGHT: Stairs = Stairs {
         start: [0.0, 0.0],
@@ -142,6 +164,28 @@ mod tests {
         assert!((height - 0.45).abs() < 1e-12);
         assert!((s.max_height() - 0.45).abs() < 1e-12);
         assert_eq!(s.flight_steps(), Some(3));
+    }
+
+    #[test]
+    fn a_flight_as_boxes_is_the_same_solids_bit_for_bit() {
+        // At odd headings too, where the boxes' centres come out of sin and cos: each box
+        // is the flight's solid for its step, and its top the step's height.
+        for yaw_deg in [0.0, 17.3, -56.5, 180.0] {
+            let s = Stairs { yaw_deg, start: [1.3, -0.7], ..FLIGHT };
+            let flight = Primitive::Stairs(s);
+            let boxes = flight.as_boxes();
+            assert_eq!(boxes.len(), 3);
+            let solids: Vec<Solid> = boxes.iter().flat_map(Primitive::solids).collect();
+            assert_eq!(solids, flight.solids(), "yaw {yaw_deg}");
+            assert!(boxes.iter().all(|b| b.flight_steps().is_none() && b.kind() == "box"));
+        }
+        // Other kinds are themselves.
+        let pole = Primitive::Pole(crate::scenario::terrain::Pole {
+            center: [0.0, 0.0],
+            radius: 0.1,
+            height: 0.2,
+        });
+        assert_eq!(pole.as_boxes(), vec![pole.clone()]);
     }
 
     #[test]
