@@ -380,16 +380,14 @@ pub struct PlannerArgs {
     /// ramp_detour and ramp_far).
     #[arg(long, allow_negative_numbers = true)]
     pub step_cost_factor: Option<f64>,
-    /// Foot model of the foot cost (default: the scenario's `[params] foot_model`; where
-    /// it names none, `wheel_pair` on terrain with stairs, else `paper`): `paper`, the
-    /// paper's disc of radius r_F (eq. 2), or `wheel_pair`, the wheel pair's contact
-    /// footprint at the foot's heading.
+    /// Foot model of the foot cost, for experiments (default: `wheel_pair`, the wheel
+    /// pair's contact footprint at the foot's heading, on every course; or the scenario's
+    /// `[params] foot_model`): `paper` is the paper's disc of radius r_F (eq. 2).
     #[arg(long, value_enum)]
     pub foot_model: Option<FootModelArg>,
-    /// Which manoeuvres prepare steps (default: the scenario's `[params] step_model`, or
-    /// where it names none `stairs` on a flight of four steps or more, else `paper`):
-    /// `paper`, the paper's manoeuvres, or `stairs`, which add those a flight longer than
-    /// the robot needs.
+    /// Which manoeuvres prepare steps, for experiments (default: `stairs`, every manoeuvre
+    /// where the terrain calls for it, on every course; or the scenario's `[params]
+    /// step_model`): `paper` is the paper's manoeuvres alone.
     #[arg(long, value_enum)]
     pub step_model: Option<StepModelArg>,
 }
