@@ -8,7 +8,7 @@ use crate::rng::Rng;
 use crate::scenario::Outcome;
 
 /// Height of the `up_and_over` block, m.
-pub const UP_AND_OVER_HEIGHT_M: Span = Span::new(0.08, 0.30);
+pub const UP_AND_OVER_HEIGHT_M: Span = Span::new(0.08, 0.25);
 /// Depth of the `up_and_over` block along the path, m.
 pub const UP_AND_OVER_DEPTH_M: Span = Span::new(0.8, 2.0);
 
