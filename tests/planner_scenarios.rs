@@ -268,6 +268,12 @@ fn a_flight_written_as_boxes_plans_as_the_labelled_flight() {
             |p: &PlanSummary| p.path.iter().map(|e| (e.kind, e.leg, e.pose)).collect::<Vec<_>>();
         assert_eq!(poses(&a), poses(&b), "{name}: the same path");
     }
+    // The shipped box version of the indoor flight (written by hand, to the millimetre)
+    // plans as the labelled flight.
+    let (a, b) =
+        (plan(&scenario("stairs_indoor"), &probe), plan(&scenario("stairs_indoor_boxes"), &probe));
+    assert_eq!((a.cost, a.expansions), (b.cost, b.expansions), "stairs_indoor_boxes");
+    assert_eq!(a.path.len(), b.path.len(), "stairs_indoor_boxes");
 }
 
 #[test]
