@@ -23,7 +23,7 @@ use super::keyframe::{Keyframe, Phase};
 use crate::cost::CostMaps;
 use crate::feasibility::{DrivingCheck, Infeasible, MotionOptions};
 use crate::geometry::{Pose2, wrap_angle};
-use crate::path::ManoeuvreKind;
+use crate::path::{ManoeuvreKind, PathElement};
 use crate::posture::CenterOfMassModel;
 use crate::posture::kinematics::base_z_in;
 use crate::posture::kinematics::{
@@ -240,13 +240,31 @@ impl<'a> Expander<'a> {
         Ok(())
     }
 
-    /// The error of a path element of `kind` that names no leg where it must.
-    pub(crate) fn unnamed_leg(&self, kind: ManoeuvreKind) -> MotionError {
-        MotionError::Manoeuvre {
+    /// The leg a path element of a one-leg manoeuvre names.
+    ///
+    /// # Errors
+    /// [`MotionError::Manoeuvre`] where it names none.
+    pub(crate) fn leg_of(&self, el: &PathElement) -> Result<Leg, MotionError> {
+        el.leg.ok_or_else(|| MotionError::Manoeuvre {
             index: self.index,
-            kind: kind.name(),
+            kind: el.kind.name(),
             reason: "no leg named".to_owned(),
-        }
+        })
+    }
+
+    /// Before path element `k`, a manoeuvre standing on its feet: stands up if driving
+    /// ([`Self::stand_if_driving`]), then settles at the pose before it ([`Self::settle`]).
+    ///
+    /// # Errors
+    /// [`MotionError::Manoeuvre`] where no standing posture holds.
+    pub(crate) fn stand_before(
+        &mut self,
+        path: &[PathElement],
+        k: usize,
+    ) -> Result<(), MotionError> {
+        let kind = path[k].kind;
+        self.stand_if_driving(kind)?;
+        self.settle(kind, &path[k - 1].pose)
     }
 
     pub(crate) fn ground(&self, x: f64, y: f64) -> Result<f64, MotionError> {

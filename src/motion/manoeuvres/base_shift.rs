@@ -103,8 +103,7 @@ impl Unit for BaseShift {
         k: usize,
     ) -> Result<(), MotionError> {
         let el = &path[k];
-        ex.stand_if_driving(el.kind)?;
-        ex.settle(el.kind, &path[k - 1].pose)?;
+        ex.stand_before(path, k)?;
         ex.expand_base_shift(el.kind, el.feet, &el.pose)
     }
 }

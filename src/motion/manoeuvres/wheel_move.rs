@@ -65,11 +65,8 @@ impl Unit for WheelMove {
         k: usize,
     ) -> Result<(), MotionError> {
         let el = &path[k];
-        ex.stand_if_driving(el.kind)?;
-        let Some(leg) = el.leg else {
-            return Err(ex.unnamed_leg(el.kind));
-        };
-        ex.settle(el.kind, &path[k - 1].pose)?;
+        let leg = ex.leg_of(el)?;
+        ex.stand_before(path, k)?;
         ex.expand_wheel_move(el.kind, leg, el.feet[leg.index()])
     }
 }

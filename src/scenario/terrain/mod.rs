@@ -28,7 +28,7 @@ pub use pole::Pole;
 pub use ramp::Ramp;
 pub use stairs::Stairs;
 
-use super::field::FieldError;
+use super::field::{FieldError, finite, positive};
 use serde::{Deserialize, Serialize};
 
 /// One terrain primitive, as written in a scenario's `[[terrain]]` array: the
@@ -211,6 +211,52 @@ fn to_local(origin: [f64; 2], yaw: f64, x: f64, y: f64) -> (f64, f64) {
 fn to_world(origin: [f64; 2], yaw: f64, lx: f64, ly: f64) -> [f64; 2] {
     let (s, c) = yaw.sin_cos();
     [origin[0] + c * lx - s * ly, origin[1] + s * lx + c * ly]
+}
+
+/// A rectangle footprint rotated about its centre, with a height: what the `box` and
+/// `ramp` primitives share (their fields' checks, their local frame, their bounds).
+struct Rectangle {
+    center: [f64; 2],
+    size: [f64; 2],
+    height: f64,
+    yaw_deg: f64,
+}
+
+impl Rectangle {
+    /// The fields' checks, each error naming `at`'s field.
+    fn validate(&self, at: &str) -> Result<(), FieldError> {
+        finite(&format!("{at}.center"), self.center[0])?;
+        finite(&format!("{at}.center"), self.center[1])?;
+        positive(&format!("{at}.size"), self.size[0])?;
+        positive(&format!("{at}.size"), self.size[1])?;
+        positive(&format!("{at}.height"), self.height)?;
+        finite(&format!("{at}.yaw_deg"), self.yaw_deg)
+    }
+
+    fn well_formed(&self) -> bool {
+        all_finite(&[self.center[0], self.center[1], self.height, self.yaw_deg])
+            && all_non_negative(&self.size)
+    }
+
+    /// The local coordinates (x along the rectangle's length from its centre) of a world
+    /// point inside it.
+    fn local_inside(&self, x: f64, y: f64) -> Option<(f64, f64)> {
+        let (lx, ly) = to_local(self.center, self.yaw_deg.to_radians(), x, y);
+        inside_centered(lx, ly, self.size).then_some((lx, ly))
+    }
+
+    fn half_size(&self) -> [f64; 2] {
+        [self.size[0] / 2.0, self.size[1] / 2.0]
+    }
+
+    fn bounds(&self) -> [f64; 4] {
+        let [hx, hy] = self.half_size();
+        rotated_bounds(
+            self.center,
+            self.yaw_deg.to_radians(),
+            [(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)],
+        )
+    }
 }
 
 /// The bounding box `[x_min, y_min, x_max, y_max]` of the local points `corners` of a

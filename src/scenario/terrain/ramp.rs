@@ -2,10 +2,8 @@
 //! linearly along its local +x. It is one [`Solid::Wedge`], a convex mesh that stays in
 //! the simulated world's own body (see `sim::world`).
 
-use super::{
-    PrimitiveKind, Solid, all_finite, all_non_negative, inside_centered, rotated_bounds, to_local,
-};
-use crate::scenario::field::{FieldError, finite, positive};
+use super::{PrimitiveKind, Rectangle, Solid};
+use crate::scenario::field::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// A wedge rising linearly along its local +x from 0 to `height`.
@@ -29,22 +27,16 @@ impl PrimitiveKind for Ramp {
     }
 
     fn validate(&self, at: &str) -> Result<(), FieldError> {
-        finite(&format!("{at}.center"), self.center[0])?;
-        finite(&format!("{at}.center"), self.center[1])?;
-        positive(&format!("{at}.size"), self.size[0])?;
-        positive(&format!("{at}.size"), self.size[1])?;
-        positive(&format!("{at}.height"), self.height)?;
-        finite(&format!("{at}.yaw_deg"), self.yaw_deg)
+        self.rectangle().validate(at)
     }
 
     fn well_formed(&self) -> bool {
-        all_finite(&[self.center[0], self.center[1], self.height, self.yaw_deg])
-            && all_non_negative(&self.size)
+        self.rectangle().well_formed()
     }
 
     fn surface_height(&self, x: f64, y: f64) -> Option<f64> {
-        let (lx, ly) = to_local(self.center, self.yaw_deg.to_radians(), x, y);
-        inside_centered(lx, ly, self.size).then(|| self.height * (lx / self.size[0] + 0.5))
+        let inside = self.rectangle().local_inside(x, y);
+        inside.map(|(lx, _)| self.height * (lx / self.size[0] + 0.5))
     }
 
     fn max_height(&self) -> f64 {
@@ -52,21 +44,27 @@ impl PrimitiveKind for Ramp {
     }
 
     fn footprint_bounds(&self) -> [f64; 4] {
-        let (hx, hy) = (self.size[0] / 2.0, self.size[1] / 2.0);
-        rotated_bounds(
-            self.center,
-            self.yaw_deg.to_radians(),
-            [(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)],
-        )
+        self.rectangle().bounds()
     }
 
     fn solids(&self) -> Vec<Solid> {
         vec![Solid::Wedge {
             center: self.center,
-            half_size: [self.size[0] / 2.0, self.size[1] / 2.0],
+            half_size: self.rectangle().half_size(),
             height: self.height,
             yaw: self.yaw_deg.to_radians(),
         }]
+    }
+}
+
+impl Ramp {
+    fn rectangle(&self) -> Rectangle {
+        Rectangle {
+            center: self.center,
+            size: self.size,
+            height: self.height,
+            yaw_deg: self.yaw_deg,
+        }
     }
 }
 

@@ -125,11 +125,8 @@ impl Unit for Step {
         k: usize,
     ) -> Result<(), MotionError> {
         let el = &path[k];
-        ex.stand_if_driving(el.kind)?;
-        let Some(leg) = el.leg else {
-            return Err(ex.unnamed_leg(el.kind));
-        };
-        ex.settle(el.kind, &path[k - 1].pose)?;
+        let leg = ex.leg_of(el)?;
+        ex.stand_before(path, k)?;
         let f = el.feet[leg.index()];
         let post_foot = [f[0], f[1], ex.ground(f[0], f[1])?];
         ex.expand_step(leg, post_foot)?;
