@@ -29,14 +29,12 @@ pub struct Params {
     /// Untraversable height difference for a wheel (eq. 2): 0.05 m.
     pub max_foot_height_diff_m: f64,
     /// Which ground a foot must find free of height differences above
-    /// `max_foot_height_diff_m` (eq. 2, first case): the wheel pair's own contact
-    /// footprint at the foot's heading (the default), or the paper's disc of radius
-    /// `r_f_m` (see [`FootModel`] and `cost::foot`). One model for every course: nothing
-    /// about a course chooses it; a scenario may name the other for experiments.
+    /// `max_foot_height_diff_m` (eq. 2, first case): the paper's disc of radius `r_f_m`
+    /// (the default) or the wheel pair's own contact footprint at the foot's heading
+    /// (see [`FootModel`] and `cost::foot`).
     pub foot_model: FootModel,
-    /// Which manoeuvres prepare steps (see [`StepModel`]): all of them, each offered
-    /// where the terrain calls for it (`stairs`, the default), or the paper's alone. One
-    /// model for every course, as `foot_model`.
+    /// Which manoeuvres prepare steps (see [`StepModel`]): `paper` (the default) or
+    /// `stairs`.
     pub step_model: StepModel,
 
     /// Body cost weight k2 on missing clearance under the base (eq. 3).
@@ -142,8 +140,8 @@ impl Default for Params {
             r_f_m: 0.12,
             r_n_m: 0.3,
             max_foot_height_diff_m: 0.05,
-            foot_model: FootModel::WheelPair,
-            step_model: StepModel::Stairs,
+            foot_model: FootModel::Paper,
+            step_model: StepModel::Paper,
             k2: 1.0,
             k3: 0.5,
             base_circle_radius_m: 0.25,
@@ -183,13 +181,12 @@ impl Default for Params {
 pub enum FootModel {
     /// The paper's (eq. 2): infinite when a height difference above the limit lies
     /// closer than r_F to the cell, whatever the foot's heading.
+    #[default]
     Paper,
     /// The wheel pair's contact footprint: the two wheels of the model (radius and
     /// spacing read from the model file), side by side across the foot's heading, which
     /// is the base heading. Infinite when a height difference above the limit lies under
-    /// a wheel at that heading; the r_N sum (eq. 1) is the paper's. The default: what
-    /// the robot stands on, on every course.
-    #[default]
+    /// a wheel at that heading; the r_N sum (eq. 1) is the paper's.
     WheelPair,
 }
 
@@ -209,20 +206,19 @@ impl FootModel {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StepModel {
-    /// The paper's manoeuvres (Sec. V) alone, the front feet never behind neutral: no
-    /// path up a flight longer than the robot's feet span (four or more building-code
-    /// steps). For experiments.
-    Paper,
-    /// The paper's manoeuvres and those short treads need, each offered where the terrain
-    /// calls for it: the rear-step approach (a base shift past the front feet's neutral
-    /// where the front and rear feet stand on different levels and a front foot's way
-    /// ahead is blocked, so a rear foot reaches a riser while the front feet stand on a
-    /// short tread), the climb shift (on a climb under way, the base forward past the front
-    /// feet's neutral so a rear foot can step and the front legs reach the next tread), a
-    /// foot short of an obstacle rolled up to it, and the generator's partner wheel
-    /// stopping short of where its leg leaves reach before a step (with `paper` such a
-    /// step fails). The default, on every course.
+    /// The paper's manoeuvres (Sec. V), the front feet never behind neutral. Fast on the
+    /// paper's scenarios; it climbs three building-code steps but finds no path up a
+    /// flight longer than the robot's feet span (four or more).
     #[default]
+    Paper,
+    /// Adds the rear-step approach (a base shift past the front feet's neutral, where
+    /// their way ahead is blocked, so a rear foot reaches a riser while the front feet
+    /// stand on a short tread), the climb shift (on a flight longer than the robot, the
+    /// base forward past the front feet's neutral so a rear foot can step and the front
+    /// legs reach the next tread), and the generator's partner wheel stops short of
+    /// where its leg leaves reach before a step (with `paper` such a step fails).
+    /// Climbs and descends building-code stairs; plans the paper's staircase slower, as
+    /// more manoeuvres are open.
     Stairs,
 }
 

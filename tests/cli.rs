@@ -224,10 +224,10 @@ fn models_are_checked_in_the_file_and_on_the_command_line() {
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
         (v["foot_model"].clone(), v["step_model"].clone())
     };
-    // Every course gets the one model; the options still override it for experiments.
-    assert_eq!(plan(&[]), ("wheel_pair".into(), "stairs".into()));
-    let overridden = plan(&["--foot-model", "paper", "--step-model", "paper"]);
-    assert_eq!(overridden, ("paper".into(), "paper".into()));
+    // Flat ground names no models and has no stairs: the paper's.
+    assert_eq!(plan(&[]), ("paper".into(), "paper".into()));
+    let overridden = plan(&["--foot-model", "wheel_pair", "--step-model", "stairs"]);
+    assert_eq!(overridden, ("wheel_pair".into(), "stairs".into()));
 }
 
 #[test]

@@ -209,8 +209,7 @@ fn platform_whole_path_is_stable_and_failures_name_the_step() {
 #[test]
 fn a_blocked_wheel_leaves_the_alignment_to_a_base_shift() {
     // Flat ground. The front-left foot steps 0.3 m over a low bar (0.1 m); a block just
-    // ahead of the rear-left wheel (hip at x = −0.35 m, wheels 0.08 m in radius; the
-    // block's face at −0.26 m) keeps that wheel from driving toward the centre
+    // ahead of the rear-left wheel keeps that wheel from driving toward the centre
     // (Fig. 12a), so the generator aligns the CoM with the support triangle by shifting
     // the base instead (Fig. 12b), and shifts it back after the step.
     let text = r#"
@@ -233,7 +232,7 @@ size = [0.06, 0.5]
 height = 0.1
 [[terrain]]
 kind = "box"
-center = [-0.235, 0.32]
+center = [-0.2, 0.32]
 size = [0.05, 0.3]
 height = 0.1
 "#;

@@ -733,14 +733,9 @@ mod tests {
     }
 
     /// A 5 m x 5 m map from (0, 0); cell centres at odd multiples of 0.0125 m.
-    /// The paper's foot model (its r_F disc), for values computed by hand from it.
-    fn paper() -> Params {
-        Params { foot_model: FootModel::Paper, ..Params::default() }
-    }
-
     fn maps_of(primitives: &[Primitive]) -> CostMaps {
         let m = rasterise(primitives, [0.0, 0.0], [5.0, 5.0], RES).unwrap();
-        CostMaps::build(&m, &robot(), &paper()).unwrap()
+        CostMaps::build(&m, &robot(), &Params::default()).unwrap()
     }
 
     /// The pose at the centre of cell (100, 100), facing +x.
@@ -897,7 +892,7 @@ mod tests {
             yaw_deg: 0.0,
         })];
         let m = rasterise(&prims, [0.0, 0.0], [5.0, 5.0], RES).unwrap();
-        let paper = CostMaps::build(&m, &robot(), &paper()).unwrap();
+        let paper = CostMaps::build(&m, &robot(), &Params::default()).unwrap();
         let wp_params = Params { foot_model: FootModel::WheelPair, ..Params::default() };
         let wp = CostMaps::build(&m, &robot(), &wp_params).unwrap();
         let (x, y) = (2.9625, 2.5125);

@@ -22,7 +22,7 @@ use super::{HybridGraph, LatticeState, ManoeuvreStats, Neighbourhood, PoseKey};
 use crate::params::{FootModel, StepModel};
 use crate::path::{ManoeuvreKind, PathElement};
 use crate::robot::RobotDescription;
-use crate::scenario::Scenario;
+use crate::scenario::{PAPER_MODEL_FLIGHT_STEPS, Scenario, longest_flight};
 use crate::search::Algorithm;
 use crate::search::{
     Cost, ExpandHook, Expansion, Hooks, SearchError, SearchParams, SearchResult, Termination,
@@ -278,6 +278,20 @@ pub fn run_on_counted(
     search_prepared(prep, scenario, robot, opts, (Instant::now(), limit), counts)
 }
 
+/// What a "no path" adds for a scenario planned with the paper's step model whose
+/// terrain has a flight of [`PAPER_MODEL_FLIGHT_STEPS`] or more: the models that climb
+/// it. Empty otherwise.
+fn stairs_model_hint(scenario: &Scenario, step_model: StepModel) -> String {
+    match longest_flight(&scenario.terrain) {
+        Some(n) if step_model == StepModel::Paper && n >= PAPER_MODEL_FLIGHT_STEPS => format!(
+            "; its stairs have {n} steps, and with step_model = \"paper\" flights of \
+             {PAPER_MODEL_FLIGHT_STEPS} or more have no path: set step_model = \"stairs\" \
+             and foot_model = \"wheel_pair\" in its [params] (README, \"Step model\")"
+        ),
+        _ => String::new(),
+    }
+}
+
 /// The search of [`run`] and [`run_on`] on `prep`, its time limit `limit` counted from
 /// `t0`.
 fn search_prepared(
@@ -345,6 +359,7 @@ fn search_prepared(
             ),
             t => format!("the search stopped ({})", termination_name(t)),
         };
+        let reason = reason + &stairs_model_hint(scenario, prep.params.step_model);
         return Err(PlanError::NoPath {
             scenario: file(),
             termination: result.termination,
@@ -499,5 +514,30 @@ mod tests {
         let said = super::step_checks_said(&copied);
         let copies = "1 otherwise; 7 more steps turned away as copies of failed checks elsewhere";
         assert!(said.ends_with(copies), "{said}");
+    }
+
+    #[test]
+    fn a_long_flight_planned_with_the_paper_step_model_is_told_the_stairs_models() {
+        // The repository's six-step flight names the stairs models; without them (or with
+        // the paper's) a "no path" says which to set, and so does a four-step flight; a
+        // three-step one (which the paper's model climbs) and the stairs model get none.
+        use crate::params::StepModel;
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/stairs_long.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let sc = crate::scenario::Scenario::parse(&text, &path).unwrap();
+        assert_eq!(super::stairs_model_hint(&sc, StepModel::Stairs), "");
+        let hint = super::stairs_model_hint(&sc, StepModel::Paper);
+        assert!(
+            hint.starts_with("; its stairs have 6 steps")
+                && hint.contains("step_model = \"stairs\"")
+                && hint.contains("foot_model = \"wheel_pair\""),
+            "{hint}"
+        );
+        for (steps, hinted) in [(4, true), (3, false)] {
+            let t = text.replace("steps = 6", &format!("steps = {steps}"));
+            let sc = crate::scenario::Scenario::parse(&t, &path).unwrap();
+            assert_eq!(!super::stairs_model_hint(&sc, StepModel::Paper).is_empty(), hinted);
+        }
     }
 }

@@ -6,18 +6,23 @@
 //! wrong plan. The terrain primitives feed both the MuJoCo world (`sim::world`) and the
 //! rasterised height map (`terrain`).
 //!
-//! **Nothing in a file labels the planner's models.** The planner plans from the height
-//! map and the robot model alone: a flight written as a `stairs` primitive and the same
-//! flight written as stacked boxes are the same heights and get the same plan. `[params]`
-//! may still name `foot_model` and `step_model` for experiments; otherwise every course
-//! gets [`Params`]' one model.
+//! **Models a file does not name.** `[params]` may name `foot_model` and `step_model`;
+//! where it does not and the terrain has a flight of stairs, the scenario takes the models
+//! that climb stairs rather than [`Params`]' defaults, which are the paper's
+//! ([`default_models`]): the wheel pair's own contact footprint (the paper's r_F disc
+//! leaves 5 cm of foothold on a 0.29 m tread, less than the robot's 16 cm wheels stand on,
+//! and a three-step indoor flight had no path), and from [`PAPER_MODEL_FLIGHT_STEPS`]
+//! steps on the stairs manoeuvres, without which no flight longer than the robot is
+//! climbed. Terrain without stairs keeps the paper's models: beside walls the wheel pair
+//! needs 2 cm more than the disc, and doorways that the robot drove through it stepped
+//! through. A file that names a model gets it.
 
 mod field;
 pub mod generate;
 pub mod terrain;
 
 use crate::geometry::Pose2;
-use crate::params::Params;
+use crate::params::{FootModel, Params, StepModel};
 use field::{FieldError, finite, non_negative, positive};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -165,6 +170,13 @@ pub const DEFAULT_MAX_STATIC_VIOLATION_S: f64 = 0.1;
 /// abort in an allocation.
 pub const MAX_MAP_CELLS: f64 = 4.0e6;
 
+/// Flights of this many steps or more have no path with the paper's step model: its
+/// front feet never stand behind neutral, so the feet of one side stay a hip spacing
+/// (0.7 m) apart, and on a flight longer than the robot's 0.8 m feet span no footprint
+/// lets a rear foot step while the front feet stand on a tread (README, "Step model").
+/// A scenario that names no step model gets `stairs` for them ([`default_models`]).
+pub const PAPER_MODEL_FLIGHT_STEPS: u32 = 4;
+
 /// The file format, exactly as written.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -182,6 +194,36 @@ struct ScenarioFile {
     params: Params,
     #[serde(default)]
     expect: Expectations,
+}
+
+/// Which models a file's `[params]` names (the rest of the file is [`ScenarioFile`]'s).
+#[derive(Debug, Default, Deserialize)]
+struct NamedModels {
+    #[serde(default)]
+    params: NamedModelKeys,
+}
+
+/// The model keys of `[params]`, present or not.
+#[derive(Debug, Default, Deserialize)]
+struct NamedModelKeys {
+    foot_model: Option<toml::Value>,
+    step_model: Option<toml::Value>,
+}
+
+/// The models of a scenario whose file names none (module docs): on terrain with a
+/// flight of stairs the wheel pair's footprint, and the stairs manoeuvres from a flight of
+/// [`PAPER_MODEL_FLIGHT_STEPS`] steps on; elsewhere the paper's.
+pub fn default_models(terrain: &[Primitive]) -> (FootModel, StepModel) {
+    match longest_flight(terrain) {
+        None => (FootModel::Paper, StepModel::Paper),
+        Some(n) if n >= PAPER_MODEL_FLIGHT_STEPS => (FootModel::WheelPair, StepModel::Stairs),
+        Some(_) => (FootModel::WheelPair, StepModel::Paper),
+    }
+}
+
+/// The most steps of any `stairs` primitive of `terrain`; `None` without stairs.
+pub fn longest_flight(terrain: &[Primitive]) -> Option<u32> {
+    terrain.iter().filter_map(Primitive::flight_steps).max()
 }
 
 /// A loaded, validated scenario.
@@ -236,7 +278,16 @@ impl Scenario {
             reason,
         };
         validate(&file).map_err(|(field, reason)| invalid(&field, reason))?;
-        let params = file.params;
+        // The same text parsed above, so this cannot fail where that did not.
+        let named: NamedModels = toml::from_str(text).unwrap_or_default();
+        let mut params = file.params;
+        let (foot, step) = default_models(&file.terrain);
+        if named.params.foot_model.is_none() {
+            params.foot_model = foot;
+        }
+        if named.params.step_model.is_none() {
+            params.step_model = step;
+        }
         let name = file.name.clone().unwrap_or_else(|| {
             path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
         });
@@ -432,15 +483,9 @@ mod tests {
 
     #[test]
     fn foot_model_parses_and_a_bad_one_names_the_choices() {
-        use crate::params::{FootModel, StepModel};
-        // One model for every course, whatever the terrain; a file may name another.
-        let s = parse(GOOD).unwrap();
-        assert_eq!(
-            (s.params.foot_model, s.params.step_model),
-            (FootModel::WheelPair, StepModel::Stairs)
-        );
-        let paper = GOOD.replace("[params]", "[params]\nfoot_model = \"paper\"");
-        assert_eq!(parse(&paper).unwrap().params.foot_model, FootModel::Paper);
+        assert_eq!(parse(GOOD).unwrap().params.foot_model, FootModel::Paper);
+        let wp = GOOD.replace("[params]", "[params]\nfoot_model = \"wheel_pair\"");
+        assert_eq!(parse(&wp).unwrap().params.foot_model, FootModel::WheelPair);
         let e = parse(&GOOD.replace("[params]", "[params]\nfoot_model = \"wheels\"")).unwrap_err();
         assert!(matches!(e, ScenarioError::Parse { .. }));
         let msg = e.to_string();
@@ -448,6 +493,43 @@ mod tests {
             msg.contains("foot_model") && msg.contains("`paper`") && msg.contains("`wheel_pair`"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn models_a_file_does_not_name_fit_its_terrain() {
+        // `Params` keeps the paper's, and so does terrain without stairs; a flight in a
+        // file naming no model gets the wheel pair, and the stairs manoeuvres from four
+        // steps on; a named model is kept.
+        assert_eq!(
+            (Params::default().foot_model, Params::default().step_model),
+            (FootModel::Paper, StepModel::Paper)
+        );
+        let flight = |steps: u32, params: &str| {
+            let stairs = format!(
+                "[[terrain]]\nkind = \"stairs\"\nstart = [1.0, -1.4]\nwidth = 0.8\n\
+                 steps = {steps}\nstep_depth = 0.29\nstep_height = 0.17\n[params]\n{params}"
+            );
+            let s = parse(&GOOD.replace("[params]", &stairs)).unwrap();
+            (s.params.foot_model, s.params.step_model)
+        };
+        let (wheels, paper, stairs) = (FootModel::WheelPair, StepModel::Paper, StepModel::Stairs);
+        assert_eq!(flight(3, ""), (wheels, paper));
+        assert_eq!(flight(PAPER_MODEL_FLIGHT_STEPS, ""), (wheels, stairs));
+        assert_eq!(flight(12, ""), (wheels, stairs));
+        assert_eq!(flight(6, "step_model = \"paper\""), (wheels, paper));
+        assert_eq!(flight(2, "step_model = \"stairs\""), (wheels, stairs));
+        assert_eq!(flight(6, "foot_model = \"paper\""), (FootModel::Paper, stairs));
+        // Terrain without stairs, and a file without a [params] table at all.
+        let bare = GOOD.split("[params]").next().unwrap();
+        let s = parse(bare).unwrap();
+        assert_eq!((s.params.foot_model, s.params.step_model), (FootModel::Paper, paper));
+        let bare = bare.replace(
+            "[[terrain]]",
+            "[[terrain]]\nkind = \"stairs\"\nstart = [1.0, -1.4]\nwidth = 0.8\nsteps = 5\n\
+             step_depth = 0.29\nstep_height = 0.17\n[[terrain]]",
+        );
+        let s = parse(&bare).unwrap();
+        assert_eq!((s.params.foot_model, s.params.step_model), (wheels, stairs));
     }
 
     #[test]

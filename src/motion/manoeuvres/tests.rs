@@ -47,22 +47,6 @@ fn config() -> HybridConfig {
     HybridConfig::new(&Params::default(), &robot(), Neighbourhood::N16)
 }
 
-/// The paper's foot and step models: for values computed by hand from its r_F disc (the
-/// untraversable band before an edge is 2 r_F wide) and its manoeuvres.
-fn paper() -> Params {
-    Params {
-        foot_model: crate::params::FootModel::Paper,
-        step_model: crate::params::StepModel::Paper,
-        ..Params::default()
-    }
-}
-
-/// [`graph`] with [`paper`]'s models.
-fn paper_graph<'c>(maps: &'c CostMaps, goal: LatticeState) -> HybridGraph<'c> {
-    let cfg = HybridConfig::new(&paper(), &robot(), Neighbourhood::N16);
-    HybridGraph::new(maps, &robot(), 64, cfg, DrivingGoal::at(goal), &ALL).expect("graph")
-}
-
 #[test]
 fn a_doorway_in_a_wall_whose_top_no_foot_reaches_is_closed_at_once() {
     // `impossible_005111` (generated), square to the map: a 0.31 m doorway in a wall
@@ -630,13 +614,10 @@ fn translated_step_failures_turn_away_only_steps_that_fail() {
         Primitive::Box(Block { center: [2.6, 0.0], size: [0.4, 6.0], height: 0.2, yaw_deg: 0.0 }),
     ];
     let m = rasterise(&prims, [-1.5, -3.0], [6.0, 6.0], 0.025).expect("map");
-    let maps = CostMaps::build(&m, &robot(), &paper()).expect("cost maps");
+    let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
     let goal = state_on(&maps, 3.4, 0.0, 0.0);
     let new_graph = |reuse: bool| {
-        let cfg = HybridConfig {
-            reuse_translated_step_failures: reuse,
-            ..HybridConfig::new(&paper(), &robot(), Neighbourhood::N16)
-        };
+        let cfg = HybridConfig { reuse_translated_step_failures: reuse, ..config() };
         HybridGraph::new(&maps, &robot(), 64, cfg, DrivingGoal::at(goal), &ALL).expect("graph")
     };
     let (mut reusing, mut checking) = (new_graph(true), new_graph(false));
@@ -772,15 +753,11 @@ fn step_bound_is_one_platform_step_per_foot() {
     // The offset potential takes c = f · k11 · C_F,min per metre of offset, paid by
     // the share λ = c / (f · k7) of eq. 5's k7 term. Per foot
     // f · ((1 − λ) · k7 · L + k9 · 0.2), with C_F = 1 on the flat platform.
-    let prims =
-        [Primitive::Box(Block { center: [2.0, 0.0], size: [2.0, 2.0], height: 0.2, yaw_deg: 0.0 })];
-    let m = rasterise(&prims, [-1.0, -1.0], [4.0, 2.0], 0.025).expect("map");
-    // Hand-computed with the paper's r_F disc.
-    let maps = CostMaps::build(&m, &robot(), &paper()).expect("cost maps");
+    let maps = platform_maps(0.2);
     let goal = LatticeState::new(120, 40, 0);
-    let g = paper_graph(&maps, goal);
+    let g = graph(&maps, goal);
     assert!(g.step_bound_components() >= 2, "{}", g.step_bound_components());
-    let p = paper();
+    let p = Params::default();
     let f = p.step_cost_factor;
     let octile = (1.0 + (std::f64::consts::SQRT_2 - 1.0).powi(2)).sqrt();
     let l = (11.0 / octile - std::f64::consts::SQRT_2) * 0.025 * (1.0 - 1e-9);
@@ -841,10 +818,10 @@ fn a_step_longer_than_the_legs_reach_is_no_step_edge() {
         yaw_deg: 0.0,
     })];
     let m = rasterise(&prims, [-1.0, -1.0], [5.0, 2.0], 0.025).expect("map");
-    let maps = CostMaps::build(&m, &robot(), &paper()).expect("cost maps");
+    let maps = CostMaps::build(&m, &robot(), &Params::default()).expect("cost maps");
     let goal = state_on(&maps, 3.5, 0.0, 0.0);
-    let g = paper_graph(&maps, goal);
-    let p = paper();
+    let g = graph(&maps, goal);
+    let p = Params::default();
     let f = p.step_cost_factor;
     let octile = (1.0 + (std::f64::consts::SQRT_2 - 1.0).powi(2)).sqrt();
     let l = (11.0 / octile - std::f64::consts::SQRT_2) * 0.025 * (1.0 - 1e-9);

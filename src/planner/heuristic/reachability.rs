@@ -527,18 +527,11 @@ pub(crate) mod tests {
     const LIMITS: StanceLimits =
         StanceLimits { leg_height_m: 0.45, pitch_fraction: 0.7, min_feet_spread_m: 0.3 };
 
-    /// The paper's r_F disc: no foot stands on the walls' 0.2 m tops (the wheel pair,
-    /// facing across a wall, fits on one; with no step bound here the flood would take
-    /// such a top for ground).
-    fn paper() -> Params {
-        Params { foot_model: crate::params::FootModel::Paper, ..Params::default() }
-    }
-
     /// The cost maps and lattice of `prims` on a 6 m × 4 m map, with the reference robot.
     fn world(prims: &[Primitive]) -> (CostMaps, RobotDescription, Lattice) {
         let robot = RobotDescription::reference();
         let hm = rasterise(prims, [-1.0, -2.0], [6.0, 4.0], 0.025).unwrap();
-        let maps = CostMaps::build(&hm, &robot, &paper()).unwrap();
+        let maps = CostMaps::build(&hm, &robot, &Params::default()).unwrap();
         let lattice = Lattice::for_map(maps.heights(), 64).unwrap();
         (maps, robot, lattice)
     }
@@ -604,7 +597,7 @@ pub(crate) mod tests {
         for i in 0..30 {
             hm.set(200 + i, 150, f64::NAN).unwrap();
         }
-        let maps = CostMaps::build(&hm, &robot, &paper()).unwrap();
+        let maps = CostMaps::build(&hm, &robot, &Params::default()).unwrap();
         let lattice = Lattice::for_map(maps.heights(), 64).unwrap();
         let bounds = (&LIMITS, &StepBound::zero());
         let scan = |quick| admissible_scan(&maps, &robot, &lattice, 0.25, bounds, quick).unwrap();

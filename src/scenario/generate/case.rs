@@ -7,6 +7,7 @@
 //! each `[[terrain]]` table what the primitive is for.
 
 use super::{Class, GenerateError};
+use crate::params::{FootModel, StepModel};
 use crate::scenario::{Expectations, MapExtent, Outcome, PoseSpec, Primitive, Scenario};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -61,7 +62,17 @@ struct CaseFile<'a> {
     goal: PoseSpec,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     terrain: Vec<&'a Primitive>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    params: Option<NamedModels>,
     expect: Expectations,
+}
+
+/// The models a class's files name in `[params]` (the other parameters keep
+/// [`crate::params::Params`]' defaults and are not written).
+#[derive(Serialize)]
+struct NamedModels {
+    step_model: StepModel,
+    foot_model: FootModel,
 }
 
 impl GeneratedCase {
@@ -130,6 +141,10 @@ impl GeneratedCase {
             start: self.start,
             goal: self.goal,
             terrain: self.terrain.iter().map(|p| &p.primitive).collect(),
+            params: self
+                .class
+                .models()
+                .map(|(step_model, foot_model)| NamedModels { step_model, foot_model }),
             expect: self.expectations(),
         };
         let body = toml::to_string(&file)
@@ -177,6 +192,10 @@ mod tests {
     /// The scenario a case describes, built from its fields rather than from its file.
     fn expected(c: &GeneratedCase) -> Scenario {
         let terrain: Vec<Primitive> = c.terrain.iter().map(|p| p.primitive.clone()).collect();
+        let (foot_model, step_model) = match c.class.models() {
+            Some((step, foot)) => (foot, step),
+            None => crate::scenario::default_models(&terrain),
+        };
         Scenario {
             name: c.name.clone(),
             path: Path::new("gen").join(c.file_name()),
@@ -186,7 +205,7 @@ mod tests {
             start: c.start.pose(),
             goal: c.goal.pose(),
             terrain,
-            params: Params::default(),
+            params: Params { foot_model, step_model, ..Params::default() },
             expect: c.expectations(),
         }
     }
@@ -217,8 +236,10 @@ mod tests {
             .collect();
         let want: Vec<&str> = c.terrain.iter().map(|p| p.note.as_str()).collect();
         assert_eq!(notes, want);
-        // No class names the planner's models: the files carry no [params].
-        assert!(!text.contains("[params]") && !text.contains("_model"), "{text}");
+        assert!(
+            text.contains("\n[params]\nstep_model = \"stairs\"\nfoot_model = \"wheel_pair\"\n")
+        );
+        // Classes that name no model write no [params].
         assert!(!case(Class::Clutter, 5).to_toml().unwrap().contains("[params]"));
     }
 }

@@ -11,7 +11,8 @@ use crate::scenario::Outcome;
 pub const BUMP_HEIGHT_M: Span = Span::new(0.01, 0.045);
 
 /// The class; its files name no model.
-pub(super) const UNIT: ClassUnit = ClassUnit { class: Class::Clutter, name: "clutter", draw };
+pub(super) const UNIT: ClassUnit =
+    ClassUnit { class: Class::Clutter, name: "clutter", draw, models: None };
 
 /// Draws the course's size, start, goal and waypoint, the obstacles off the way, and the
 /// bumps anywhere.

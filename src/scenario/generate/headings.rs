@@ -13,7 +13,8 @@ pub const LATTICE_STEP_DEG: f64 = 5.625;
 pub const MIN_OFF_LATTICE_DEG: f64 = 0.5;
 
 /// The class; its files name no model.
-pub(super) const UNIT: ClassUnit = ClassUnit { class: Class::Headings, name: "headings", draw };
+pub(super) const UNIT: ClassUnit =
+    ClassUnit { class: Class::Headings, name: "headings", draw, models: None };
 
 /// Distance of a yaw from the nearest multiple of [`LATTICE_STEP_DEG`], degrees.
 pub fn off_lattice_deg(yaw_deg: f64) -> f64 {

@@ -18,7 +18,8 @@ pub const TIGHT_DOOR_WIDTH_M: Span = Span::new(0.3, 0.55);
 pub const ENCLOSURE_HEIGHT_M: Span = Span::new(0.55, 1.0);
 
 /// The class; its files name no model.
-pub(super) const UNIT: ClassUnit = ClassUnit { class: Class::Impossible, name: "impossible", draw };
+pub(super) const UNIT: ClassUnit =
+    ClassUnit { class: Class::Impossible, name: "impossible", draw, models: None };
 
 /// Draws one of the three variants (0: walled-in goal, 1: high wall, 2: tight doorway).
 fn draw(rng: &mut Rng) -> Result<Course, Reject> {

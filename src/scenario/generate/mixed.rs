@@ -11,7 +11,8 @@ use crate::scenario::Outcome;
 
 /// The class; its files name no model (a climb of 2–3 steps gets the wheel pair from the
 /// scenario's defaults for its terrain).
-pub(super) const UNIT: ClassUnit = ClassUnit { class: Class::Mixed, name: "mixed", draw };
+pub(super) const UNIT: ClassUnit =
+    ClassUnit { class: Class::Mixed, name: "mixed", draw, models: None };
 
 /// Draws the clutter before the climb, the climb and the goal beyond its far edge.
 fn draw(rng: &mut Rng) -> Result<Course, Reject> {

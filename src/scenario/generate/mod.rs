@@ -11,7 +11,7 @@
 //! next draw of the same stream ([`Draws::next_case`]) when it fails.
 //!
 //! **A class is a unit.** Each class is one file (`stairs.rs`, `step_down.rs`, ...)
-//! holding its parameter ranges and its drawing function, as a
+//! holding its parameter ranges, its drawing function and the models its files name, as a
 //! `ClassUnit`; `REGISTRY` registers them, once, in `momaro generate`'s order. Adding a
 //! class is one new file, a variant of [`Class`] and its row in `REGISTRY`. The
 //! drawing helpers the classes share are `course` (numbers, the course frame, the
@@ -56,6 +56,7 @@ pub use step_down::STEP_DOWN_HEIGHT_M;
 pub use up_and_over::{UP_AND_OVER_DEPTH_M, UP_AND_OVER_HEIGHT_M};
 
 use super::Outcome;
+use crate::params::{FootModel, StepModel};
 use crate::rng::Rng;
 use course::{Course, Reject};
 use serde::Serialize;
@@ -91,6 +92,8 @@ struct ClassUnit {
     name: &'static str,
     /// Draws one course from the stream.
     draw: fn(&mut Rng) -> Result<Course, Reject>,
+    /// The step and foot models its files name in `[params]`, if any.
+    models: Option<(StepModel, FootModel)>,
 }
 
 /// The classes, registered once, in the order `momaro generate` cycles through them
@@ -148,6 +151,14 @@ impl Class {
     /// The class of case `i` of a run without `--class`: `i mod 8` in [`Class::ALL`]'s order.
     pub fn of_case(i: u64) -> Class {
         Self::ALL[(i % Self::ALL.len() as u64) as usize]
+    }
+
+    /// The step and foot models the class's files name in `[params]`, if any (only
+    /// stairs do: see `stairs.rs`). The other classes name none and get the scenario's
+    /// defaults for their terrain (`scenario::default_models`): mixed courses whose climb
+    /// is 2–3 steps get the wheel pair, the rest the paper's models.
+    pub fn models(self) -> Option<(StepModel, FootModel)> {
+        self.unit().models
     }
 }
 
@@ -419,9 +430,14 @@ mod tests {
                     assert_eq!(s.expect.min_stability_margin_m, 0.02);
                 }
                 assert!(s.map.contains(s.start.x, s.start.y) && s.map.contains(s.goal.x, s.goal.y));
-                // No class labels the planner's models: every file plans with the one
-                // model of every course.
-                assert_eq!(s.params, crate::params::Params::default(), "{}", s.name);
+                // Stairs ask for the models that climb treads shorter than the robot; the
+                // other classes name none and get the defaults for their terrain.
+                let (step, foot) = class.models().unwrap_or_else(|| {
+                    let (foot, step) = crate::scenario::default_models(&s.terrain);
+                    (step, foot)
+                });
+                assert_eq!((s.params.step_model, s.params.foot_model), (step, foot), "{}", s.name);
+                assert_eq!(class == Class::Stairs, step == StepModel::Stairs);
             }
         }
     }

@@ -11,7 +11,8 @@ use crate::scenario::Outcome;
 pub const DOOR_WIDTH_M: Span = Span::new(1.0, 1.5);
 
 /// The class; its files name no model.
-pub(super) const UNIT: ClassUnit = ClassUnit { class: Class::Narrow, name: "narrow", draw };
+pub(super) const UNIT: ClassUnit =
+    ClassUnit { class: Class::Narrow, name: "narrow", draw, models: None };
 
 /// Draws the doorway, its wall and corridor, and a start and goal on either side.
 fn draw(rng: &mut Rng) -> Result<Course, Reject> {

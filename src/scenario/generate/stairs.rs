@@ -4,6 +4,7 @@
 use super::course::{Builder, Course, Frame, Reject, Span, deg, rect, round_to};
 use super::layout::WALL_THICKNESS_M;
 use super::{Class, ClassUnit, MAX_MAP_M};
+use crate::params::{FootModel, StepModel};
 use crate::rng::Rng;
 use crate::scenario::Outcome;
 
@@ -24,7 +25,12 @@ pub const STAIR_MID_LANDING_M: Span = Span::new(0.9, 1.5);
 /// shorter than the robot's 0.7 m hip spacing, and the wheel pairs' footprint, which
 /// keeps more of a tread than the paper's disc (README, "Step model" and "Foot model"),
 /// as the repository's own stairs scenarios do.
-pub(super) const UNIT: ClassUnit = ClassUnit { class: Class::Stairs, name: "stairs", draw };
+pub(super) const UNIT: ClassUnit = ClassUnit {
+    class: Class::Stairs,
+    name: "stairs",
+    draw,
+    models: Some((StepModel::Stairs, FootModel::WheelPair)),
+};
 
 /// Draws a flight: up or down, its steps, rise, tread, width and landings, walls or not,
 /// and a yaw whose map fits.

@@ -11,7 +11,8 @@ use crate::scenario::Outcome;
 pub const STEP_DOWN_HEIGHT_M: Span = Span::new(0.05, 0.30);
 
 /// The class; its files name no model.
-pub(super) const UNIT: ClassUnit = ClassUnit { class: Class::StepDown, name: "step_down", draw };
+pub(super) const UNIT: ClassUnit =
+    ClassUnit { class: Class::StepDown, name: "step_down", draw, models: None };
 
 /// Draws the platform's height and an edge course behind whose first edge it lies.
 fn draw(rng: &mut Rng) -> Result<Course, Reject> {

@@ -13,7 +13,8 @@ pub const UP_AND_OVER_HEIGHT_M: Span = Span::new(0.08, 0.25);
 pub const UP_AND_OVER_DEPTH_M: Span = Span::new(0.8, 2.0);
 
 /// The class; its files name no model.
-pub(super) const UNIT: ClassUnit = ClassUnit { class: Class::UpAndOver, name: "up_and_over", draw };
+pub(super) const UNIT: ClassUnit =
+    ClassUnit { class: Class::UpAndOver, name: "up_and_over", draw, models: None };
 
 /// Draws the block's height and depth and an edge course whose two edges are its sides.
 fn draw(rng: &mut Rng) -> Result<Course, Reject> {
