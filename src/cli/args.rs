@@ -380,14 +380,16 @@ pub struct PlannerArgs {
     /// ramp_detour and ramp_far).
     #[arg(long, allow_negative_numbers = true)]
     pub step_cost_factor: Option<f64>,
-    /// Foot model of the foot cost, for experiments (default: `wheel_pair`, the wheel
-    /// pair's contact footprint at the foot's heading, on every course; or the scenario's
-    /// `[params] foot_model`): `paper` is the paper's disc of radius r_F (eq. 2).
+    /// Foot model of the foot cost, for experiments (default: the scenario's `[params]
+    /// foot_model`, else `wheel_pair`, the wheel pair's contact footprint at the foot's
+    /// heading, on courses with a `stairs` primitive and `paper`, the paper's disc of
+    /// radius r_F (eq. 2), elsewhere: `scenario::default_models`).
     #[arg(long, value_enum)]
     pub foot_model: Option<FootModelArg>,
-    /// Which manoeuvres prepare steps, for experiments (default: `stairs`, every manoeuvre
-    /// where the terrain calls for it, on every course; or the scenario's `[params]
-    /// step_model`): `paper` is the paper's manoeuvres alone.
+    /// Which manoeuvres prepare steps, for experiments (default: the scenario's `[params]
+    /// step_model`, else `stairs`, every manoeuvre where the terrain calls for it, on
+    /// courses with a flight of four or more steps and `paper`, the paper's manoeuvres
+    /// alone, elsewhere: `scenario::default_models`).
     #[arg(long, value_enum)]
     pub step_model: Option<StepModelArg>,
 }
