@@ -183,6 +183,53 @@ fn bench_probe_times_each_file_and_the_suite() {
 }
 
 #[test]
+fn bench_scaling_plans_one_course_on_growing_maps_and_growing_courses_on_one_map() {
+    // flat's course on 5 and 7 m maps, then 1 and 2 m straight drives on a 7 m map.
+    let out = momaro(&[
+        "bench",
+        "scaling",
+        "--map-sizes",
+        "5,7",
+        "--lengths",
+        "1,2",
+        "--length-map",
+        "7",
+        "--repeats",
+        "1",
+        "--json",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert_eq!(stderr.lines().filter(|l| l.starts_with('[')).count(), 4, "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let rows = v["rows"].as_array().expect("rows");
+    let field = |k: &str| rows.iter().map(|r| r[k].clone()).collect::<Vec<_>>();
+    assert_eq!(field("sweep"), ["area", "area", "length", "length"]);
+    assert_eq!(field("map_m"), [5.0, 7.0, 7.0, 7.0]);
+    // 2.5 cm cells: 200² and 280².
+    assert_eq!(field("cells"), [40_000, 78_400, 78_400, 78_400]);
+    let lengths: Vec<f64> = field("length_m").iter().map(|l| l.as_f64().unwrap()).collect();
+    assert!((lengths[0] - 1.5f64.hypot(1.2)).abs() < 1e-9 && lengths[0] == lengths[1]);
+    assert!((lengths[2] - 1.0).abs() < 1e-9 && (lengths[3] - 2.0).abs() < 1e-9);
+    for r in rows {
+        assert_eq!(r["outcome"], "path", "{r}");
+        let part: f64 = ["maps_s", "heuristic_setup_s", "search_s"]
+            .iter()
+            .map(|k| r[*k].as_f64().unwrap())
+            .sum();
+        assert!(part > 0.0 && part <= r["time_s"].as_f64().unwrap(), "{r}");
+    }
+    // The same course on both maps: the same plan.
+    assert_eq!(rows[0]["cost"], rows[1]["cost"]);
+    assert!(v["area_ratio"].as_f64().is_some() && v["length_ratio"].as_f64().is_some());
+    // A map too small for its course is refused by name.
+    let out = momaro(&["bench", "scaling", "--map-sizes", "3", "--lengths", "1"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("map_sizes") && !stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
 fn bad_planner_option_names_the_parameter() {
     let scenario = common::root().join("scenarios/flat.toml");
     for bad in ["nan", "-1"] {

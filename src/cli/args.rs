@@ -228,6 +228,32 @@ pub enum BenchCommand {
     Probe(BenchProbeArgs),
     /// Real-time factor of `momaro sim` against a bare mj_step loop on the same world.
     Sim(BenchSimArgs),
+    /// Cold first-path time against the map's area (one course on square maps of growing
+    /// side) and against the course's length (a straight drive of growing length on one
+    /// map): medians of the whole plan and of its parts.
+    Scaling(BenchScalingArgs),
+}
+
+/// The arguments of `momaro bench scaling`.
+#[derive(Debug, Args)]
+pub struct BenchScalingArgs {
+    /// The course's scenario (its start, goal and terrain). Default: scenarios/flat.toml
+    /// of the repository.
+    pub scenario: Option<PathBuf>,
+    /// Sides of the area sweep's square maps, m, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [6.0, 12.0, 24.0, 48.0])]
+    pub map_sizes: Vec<f64>,
+    /// Goal distances of the length sweep, m, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [1.0, 2.0, 4.0, 8.0, 16.0])]
+    pub lengths: Vec<f64>,
+    /// Side of the length sweep's square map (centred on the start), m.
+    #[arg(long, default_value_t = 48.0)]
+    pub length_map: f64,
+    /// Planning time limit of each run, s.
+    #[arg(long, default_value_t = 60.0)]
+    pub time_limit: f64,
+    #[command(flatten)]
+    pub run: BenchRunArgs,
 }
 
 /// The arguments of `momaro bench plan`.
@@ -447,7 +473,8 @@ impl PlannerArgs {
 /// What `bench plan` and `bench probe` share.
 #[derive(Debug, Args)]
 pub struct BenchRunArgs {
-    /// Runs of each search (`bench plan`) or file (`bench probe`); times are their medians.
+    /// Runs of each search (`bench plan`), file (`bench probe`) or course (`bench
+    /// scaling`); times are their medians.
     #[arg(long, default_value_t = 1)]
     pub repeats: usize,
     /// Print the result as JSON.

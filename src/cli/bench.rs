@@ -172,3 +172,86 @@ pub fn bench_sim(args: BenchSimArgs) -> anyhow::Result<bool> {
     }
     Ok(true)
 }
+
+/// `momaro bench scaling`.
+///
+/// # Errors
+/// Bad input, or a job that could not be carried out.
+pub fn bench_scaling(args: BenchScalingArgs) -> anyhow::Result<bool> {
+    let BenchScalingArgs {
+        scenario,
+        map_sizes,
+        lengths,
+        length_map,
+        time_limit,
+        run: BenchRunArgs { repeats, json, model },
+    } = args;
+    let file = scenario.unwrap_or_else(|| {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join("flat.toml")
+    });
+    let sc = load(&file)?;
+    let opts = jobs::scaling::ScalingOptions {
+        map_sizes_m: map_sizes,
+        lengths_m: lengths,
+        length_map_m: length_map,
+        time_limit_s: time_limit,
+        repeats,
+    };
+    let b =
+        jobs::scaling::scaling_bench(&sc, &robot(&model.model)?, &opts, &mut |done, total, r| {
+            use std::io::Write as _;
+            let width = total.to_string().len();
+            let _ = writeln!(
+                std::io::stderr(),
+                "[{done:>width$}/{total}] {:<6} map {:>5.1} m  course {:>5.2} m  {:<10} {:>9.1} ms",
+                r.sweep,
+                r.map_m,
+                r.length_m,
+                r.outcome,
+                r.time_s * 1e3
+            );
+        })
+        .map_err(plan_error)?;
+    if json {
+        print_json(&b)?;
+    } else {
+        say!("{} (cold first path, medians of {} runs; ms)", b.scenario, b.repeats);
+        say!(
+            "{:<7} {:>6} {:>10} {:>8} {:>10} {:>9} {:>9} {:>9} {:>10} {:>11} {:>10}",
+            "sweep",
+            "map m",
+            "cells",
+            "course m",
+            "total",
+            "maps",
+            "h setup",
+            "search",
+            "c-t-g nodes",
+            "expansions",
+            "cost"
+        );
+        for r in &b.rows {
+            say!(
+                "{:<7} {:>6.1} {:>10} {:>8.2} {:>10.1} {:>9.1} {:>9.1} {:>9.1} {:>10} {:>11} {:>10}",
+                r.sweep,
+                r.map_m,
+                r.cells,
+                r.length_m,
+                r.time_s * 1e3,
+                r.maps_s * 1e3,
+                r.heuristic_setup_s * 1e3,
+                r.search_s * 1e3,
+                r.cost_to_go_nodes,
+                r.expansions,
+                r.cost.map_or_else(|| r.outcome.to_owned(), |c| format!("{c:.3}"))
+            );
+        }
+        let ratio = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
+        say!(
+            "largest map / smallest: {}x; longest course / shortest: {}x",
+            ratio(b.area_ratio),
+            ratio(b.length_ratio)
+        );
+    }
+    Ok(true)
+}

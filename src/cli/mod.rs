@@ -38,6 +38,7 @@ pub fn run(cli: Cli) -> anyhow::Result<bool> {
         Command::Bench(BenchCommand::Plan(a)) => bench::bench_plan(a),
         Command::Bench(BenchCommand::Probe(a)) => bench::bench_probe(a),
         Command::Bench(BenchCommand::Sim(a)) => bench::bench_sim(a),
+        Command::Bench(BenchCommand::Scaling(a)) => bench::bench_scaling(a),
         Command::Generate(a) => world::generate(a),
         Command::Urdf(a) => world::urdf(a),
     }

@@ -10,4 +10,5 @@ pub mod generate;
 pub mod plan;
 pub mod plan_recording;
 pub mod run;
+pub mod scaling;
 pub mod sim;
