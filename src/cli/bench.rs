@@ -82,15 +82,12 @@ pub fn bench_probe(args: BenchProbeArgs) -> anyhow::Result<bool> {
     let scenarios =
         suite_files(&paths)?.iter().map(|f| load(f)).collect::<anyhow::Result<Vec<_>>>()?;
     let opts = jobs::bench::ProbeBenchOptions { time_limit_s: time_limit, repeats };
-    let (total, width) = (scenarios.len(), scenarios.len().to_string().len());
+    let total = scenarios.len();
     let b = jobs::bench::probe_bench(&scenarios, &robot(&model.model)?, &opts, &mut |done, r| {
-        use std::io::Write as _;
-        let _ = writeln!(
-            std::io::stderr(),
-            "[{done:>width$}/{total}] {:<24} {:<10} {:>8.1} ms",
-            r.scenario,
-            r.outcome,
-            r.time_s * 1e3
+        progress_line(
+            done,
+            total,
+            format_args!("{:<24} {:<10} {:>8.1} ms", r.scenario, r.outcome, r.time_s * 1e3),
         );
     })
     .map_err(plan_error)?;
@@ -199,16 +196,17 @@ pub fn bench_scaling(args: BenchScalingArgs) -> anyhow::Result<bool> {
     };
     let b =
         jobs::scaling::scaling_bench(&sc, &robot(&model.model)?, &opts, &mut |done, total, r| {
-            use std::io::Write as _;
-            let width = total.to_string().len();
-            let _ = writeln!(
-                std::io::stderr(),
-                "[{done:>width$}/{total}] {:<6} map {:>5.1} m  course {:>5.2} m  {:<10} {:>9.1} ms",
-                r.sweep,
-                r.map_m,
-                r.length_m,
-                r.outcome,
-                r.time_s * 1e3
+            progress_line(
+                done,
+                total,
+                format_args!(
+                    "{:<6} map {:>5.1} m  course {:>5.2} m  {:<10} {:>9.1} ms",
+                    r.sweep,
+                    r.map_m,
+                    r.length_m,
+                    r.outcome,
+                    r.time_s * 1e3
+                ),
             );
         })
         .map_err(plan_error)?;

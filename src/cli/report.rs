@@ -104,3 +104,11 @@ pub fn print_json<T: serde::Serialize>(value: &T) -> anyhow::Result<()> {
     say!("{}", serde_json::to_string_pretty(value).context("serialising the summary")?);
     Ok(())
 }
+
+/// One progress line on stderr, `[done/total] what`, the count padded to the total's
+/// width (a bench's rows as they are done; a closed pipe is not an error).
+pub fn progress_line(done: usize, total: usize, what: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let width = total.to_string().len();
+    let _ = writeln!(std::io::stderr(), "[{done:>width$}/{total}] {what}");
+}
