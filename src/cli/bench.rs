@@ -2,7 +2,7 @@
 
 use super::args::*;
 use super::report::*;
-use super::suite::suite_files;
+use super::suite::{repository_scenarios_dir, suite_files};
 use crate::jobs;
 use anyhow::Context as _;
 
@@ -183,9 +183,7 @@ pub fn bench_scaling(args: BenchScalingArgs) -> anyhow::Result<bool> {
         time_limit,
         run: BenchRunArgs { repeats, json, model },
     } = args;
-    let file = scenario.unwrap_or_else(|| {
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join("flat.toml")
-    });
+    let file = scenario.unwrap_or_else(|| repository_scenarios_dir().join("flat.toml"));
     let sc = load(&file)?;
     let opts = jobs::scaling::ScalingOptions {
         map_sizes_m: map_sizes,

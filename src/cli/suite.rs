@@ -7,12 +7,16 @@ use super::report::*;
 use crate::jobs;
 use std::path::PathBuf;
 
+/// The repository's scenarios/ directory (the commands' default files).
+pub fn repository_scenarios_dir() -> PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
+}
+
 /// The scenario files of a suite (`check`, `bench probe`): those below `paths`, sorted
 /// and de-duplicated, or every scenarios/*.toml of the repository if none is given.
 pub fn suite_files(paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     if paths.is_empty() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
-        jobs::check::repository_scenarios(&dir)
+        jobs::check::repository_scenarios(&repository_scenarios_dir())
     } else {
         jobs::check::discover(paths)
     }

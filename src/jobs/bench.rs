@@ -58,6 +58,25 @@ pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
+/// The options of `plan`'s cold first path as the benchmarks time it: the guided probe
+/// alone (`--schedule-expansions 0`) within `time_limit_s`.
+pub(crate) fn first_path_options(time_limit_s: f64) -> PlanOptions {
+    PlanOptions { time_limit_s, schedule_expansions: Some(0), ..PlanOptions::default() }
+}
+
+/// A benchmark row's outcome for a plan that failed: `no_path` (every reachable pose
+/// searched) or `time_limit` (a limit stopped it); any other failure is the benchmark's.
+///
+/// # Errors
+/// `e` itself unless it is [`PlanError::NoPath`].
+pub(crate) fn failed_outcome(e: PlanError) -> Result<&'static str, PlanError> {
+    match e {
+        PlanError::NoPath { termination: Termination::NoPath, .. } => Ok("no_path"),
+        PlanError::NoPath { .. } => Ok("time_limit"),
+        e => Err(e),
+    }
+}
+
 /// The median of `v` with `None` counted as larger than every value (a run that found
 /// no solution in time); `None` if that is where the median falls or `v` is empty.
 pub(crate) fn median_option(mut v: Vec<Option<f64>>) -> Option<f64> {
@@ -180,11 +199,7 @@ pub fn probe_bench(
     if opts.repeats == 0 {
         return Err(bad("repeats", "0 must be at least 1"));
     }
-    let plan_opts = PlanOptions {
-        time_limit_s: opts.time_limit_s,
-        schedule_expansions: Some(0),
-        ..PlanOptions::default()
-    };
+    let plan_opts = first_path_options(opts.time_limit_s);
     let mut rows = Vec::with_capacity(scenarios.len());
     for sc in scenarios {
         let (mut times, mut searches) = (Vec::new(), Vec::new());
@@ -198,11 +213,7 @@ pub fn probe_bench(
             }
             (outcome, expansions, cost) = match result {
                 Ok(s) => ("path", Some(s.expansions), Some(s.cost)),
-                Err(PlanError::NoPath { termination: Termination::NoPath, .. }) => {
-                    ("no_path", None, None)
-                }
-                Err(PlanError::NoPath { .. }) => ("time_limit", None, None),
-                Err(e) => return Err(e),
+                Err(e) => (failed_outcome(e)?, None, None),
             };
         }
         rows.push(ProbeRow {

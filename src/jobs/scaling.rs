@@ -14,13 +14,12 @@
 //! (maps, heuristic set-up, search), and what the plan did (its cost-to-go's settled
 //! nodes, expansions, cost). Times are measurements on a noisy machine, never asserted.
 
-use super::bench::median;
+use super::bench::{failed_outcome, first_path_options, median};
 use crate::geometry::Pose2;
 use crate::planner::options::bad;
-use crate::planner::{self, PlanError, PlanOptions};
+use crate::planner::{self, PlanError};
 use crate::robot::RobotDescription;
 use crate::scenario::{MapExtent, Scenario};
-use crate::search::Termination;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -192,11 +191,7 @@ pub fn scaling_bench(
             straight_course(base, opts.length_map_m, length)?,
         ));
     }
-    let plan_opts = PlanOptions {
-        time_limit_s: opts.time_limit_s,
-        schedule_expansions: Some(0),
-        ..PlanOptions::default()
-    };
+    let plan_opts = first_path_options(opts.time_limit_s);
     let total = courses.len();
     let mut rows = Vec::with_capacity(total);
     for (sweep, side, sc) in courses {
@@ -216,13 +211,11 @@ pub fn scaling_bench(
                     outcome = "path";
                     last = Some(s);
                 }
-                Err(PlanError::NoPath { termination, .. }) => {
+                Err(e) => {
+                    outcome = failed_outcome(e)?;
                     times[0].push(wall);
-                    outcome =
-                        if termination == Termination::NoPath { "no_path" } else { "time_limit" };
                     last = None;
                 }
-                Err(e) => return Err(e),
             }
         }
         let med = |k: usize| if times[k].is_empty() { 0.0 } else { median(times[k].clone()) };
