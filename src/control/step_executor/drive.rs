@@ -1,7 +1,8 @@
 //! Drive runs: consecutive drive keyframes are handed to the B-spline path follower
 //! (Sec. IX) and the omnidirectional wheel kinematics, while the legs hold the keyframes'
-//! posture interpolated at the robot's progress along the run. The follower's end of the
-//! run hands over to the next keyframe; too large a cross-track error fails.
+//! posture interpolated where the robot is along the run (on the path segment it is on,
+//! [`segment_at`]). The follower's end of the run hands over to the next keyframe; too
+//! large a cross-track error fails.
 //!
 //! **Load sharing.** The legs are position-controlled, and four stiff legs on ground the
 //! height map knows only to a cell rest on three of them: the fourth pair hangs a few
@@ -18,16 +19,16 @@
 //! to the other, a pair 4 mm up for 0.1 s with the CoM 0.85 cm inside the others' diagonal.
 //!
 //! **The base follows the ground slowly.** The feet follow the height map under the
-//! wheels, and the base rises with the highest foot, but no faster than
-//! `base_rise_speed_mps`: a base thrown up faster leaves the ground with all its wheels
-//! when the rise stops.
+//! wheels, and the base rises with the highest foot; the commanded base moves up or down
+//! no faster than `base_rise_speed_mps`, whether the ground or the plan moves it: a base
+//! thrown up faster leaves the ground with all its wheels when the rise stops.
 
 use super::actuation::pairs_in_base;
 use super::interface::STANDARD_GRAVITY;
 use super::{Command, ExecFailure, Mode, Observation, StepExecutor, planar};
 use crate::control::load_sharing::{WARP_SIGN, measured_warp, target_warp};
 use crate::control::path_follower::{FollowerStatus, PathFollower};
-use crate::geometry::wrap_angle;
+use crate::geometry::{Pose2, wrap_angle};
 use crate::posture::kinematics::{Posture, hips_in_world, interpolate};
 
 /// How far a drive run moves a foot from its keyframe height to where its wheels rest,
@@ -94,7 +95,7 @@ impl StepExecutor {
     /// `rest` (`planned` on the wheels' rest heights, [`Self::on_wheel_rest_heights`])
     /// with the base's rise moved toward its rise there by at most
     /// `base_rise_speed_mps · dt` since the last tick, the base commanded no more than
-    /// that below its last command, and each foot no higher than the driving leg height
+    /// that above or below its last command, and each foot no higher than the driving leg height
     /// allows under that base ([`Self::leg_slack`]: no leg shorter than the knees fold
     /// to). Followed at once, a wheel pair driven onto a 3.7 cm box edge at 0.45 m/s
     /// raised the base at 0.5 m/s, and when the rise stopped the robot flew on: every
@@ -111,9 +112,14 @@ impl StepExecutor {
         // tick left three pairs hanging (generated clutter seed 12067, ε = 3: the CoM
         // outside the one pair down for 30 ms). Legs that shorten no faster than the
         // robot falls in a millimetre keep their wheels loaded.
+        // Nor does it rise faster where the plan's base rises between two poses: where
+        // a blended turn on the spot puts a foot onto a bump, the keyframes' base rose
+        // 3 cm from one pose to the next, and the legs, following at once, threw the
+        // robot off all its wheels for 50 ms (generated clutter: the CoM 0.34 m outside
+        // the pair that came down first).
         let mut z = planned.base_position[2] + self.drive_rise;
         if let Some(last) = self.drive_base_z {
-            z = z.max(last - step);
+            z = z.clamp(last - step, last + step);
         }
         self.drive_rise = z - planned.base_position[2];
         self.drive_base_z = Some(z);
@@ -210,25 +216,12 @@ impl StepExecutor {
             );
             return self.hold();
         }
-        // The keyframe posture at the robot's progress along the run.
+        // The keyframe posture where the robot is along the run.
         let path = follower.path();
-        let k = out.progress_index.min(path.len() - 1);
+        let (k, t) = segment_at(path, out.progress_index.min(path.len() - 1), obs.base);
         let a_idx = first - 1 + k;
         let p = if k + 1 < path.len() {
-            let (a, b) = (path[k], path[k + 1]);
-            let (dx, dy) = (b.x - a.x, b.y - a.y);
-            let len2 = dx * dx + dy * dy;
-            let t = if len2 > 1e-8 {
-                ((obs.base.x - a.x) * dx + (obs.base.y - a.y) * dy) / len2
-            } else {
-                let dth = wrap_angle(b.theta - a.theta);
-                if dth.abs() > 1e-6 { wrap_angle(obs.base.theta - a.theta) / dth } else { 1.0 }
-            };
-            interpolate(
-                &self.keys[a_idx].posture(),
-                &self.keys[a_idx + 1].posture(),
-                t.clamp(0.0, 1.0),
-            )
+            interpolate(&self.keys[a_idx].posture(), &self.keys[a_idx + 1].posture(), t)
         } else {
             self.keys[a_idx].posture()
         };
@@ -241,6 +234,37 @@ impl StepExecutor {
         let feet = pairs_in_base(&self.robot, &p);
         let wheels = self.config.wheels.commands(&self.robot, out.twist, &feet, &obs.steering);
         Command { legs, wheels: self.with_steer_rate(wheels, obs) }
+    }
+}
+
+/// Where `base` lies along the run's `path`: the path segment it is on, as the index of
+/// its first pose, and the fraction of the segment it has covered (its projection onto the
+/// segment, or for a turn on the spot its share of the turn), in [0, 1]. `progress` is the
+/// follower's progress index, the path pose *closest* to the robot: the robot is on the
+/// segment that pose begins, or, where it has not reached that pose yet, on the one
+/// before it. (Interpolating from the closest pose alone jumped half a segment where the
+/// closest pose changed, halfway along: on generated clutter the plan's base rose 6 cm
+/// from one pose to the next, the commanded base 3.1 cm in one tick, and the legs threw
+/// the robot off all its wheels for 60 ms.)
+fn segment_at(path: &[Pose2], progress: usize, base: Pose2) -> (usize, f64) {
+    let fraction = |a: Pose2, b: Pose2| {
+        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        let len2 = dx * dx + dy * dy;
+        if len2 > 1e-8 {
+            ((base.x - a.x) * dx + (base.y - a.y) * dy) / len2
+        } else {
+            let dth = wrap_angle(b.theta - a.theta);
+            if dth.abs() > 1e-6 { wrap_angle(base.theta - a.theta) / dth } else { 1.0 }
+        }
+    };
+    let ahead = (progress + 1 < path.len()).then(|| fraction(path[progress], path[progress + 1]));
+    match ahead {
+        Some(t) if t >= 0.0 || progress == 0 => (progress, t.clamp(0.0, 1.0)),
+        _ if progress > 0 => {
+            let t = fraction(path[progress - 1], path[progress]);
+            if t < 1.0 { (progress - 1, t.max(0.0)) } else { (progress, 0.0) }
+        }
+        _ => (progress, 0.0),
     }
 }
 
@@ -447,5 +471,60 @@ mod tests {
         for i in 0..4 {
             assert!((p.feet[i][2] - q.feet[i][2] - 0.005).abs() < 1e-9, "{i}: {q:?}");
         }
+    }
+
+    #[test]
+    fn the_base_rises_with_the_plan_no_faster_than_its_rise_speed() {
+        // Flat ground, the robot at the driving height. The plan's base rises 3 cm from one
+        // tick to the next (a blended turn on the spot that puts a foot on a bump), the
+        // rest heights with it: the command rises one tick's 1.40 mm, not 3 cm, and gets
+        // there 1.40 mm a tick.
+        let flat = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |_, _| 0.0).unwrap();
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), flat);
+        let step = ex.config.base_rise_speed_mps * 0.01;
+        let p = driving();
+        let z = p.base_position[2];
+        ex.with_limited_rise(&p, p, 0.01);
+        let mut higher = p;
+        higher.base_position[2] += 0.03;
+        let q = ex.with_limited_rise(&higher, higher, 0.01);
+        assert!((q.base_position[2] - (z + step)).abs() < 1e-12, "{q:?}");
+        let mut last = q.base_position[2];
+        for _ in 0..25 {
+            let q = ex.with_limited_rise(&higher, higher, 0.01);
+            let dz = q.base_position[2] - last;
+            assert!((-1e-12..=step + 1e-12).contains(&dz), "{dz}");
+            last = q.base_position[2];
+        }
+        assert!((last - (z + 0.03)).abs() < 1e-12, "{last}");
+    }
+
+    #[test]
+    fn the_run_is_interpolated_on_the_segment_the_robot_is_on() {
+        use super::segment_at;
+        // Poses 5 cm apart along x, then a turn on the spot at the end.
+        let path = [
+            Pose2::new(0.0, 0.0, 0.0),
+            Pose2::new(0.05, 0.0, 0.0),
+            Pose2::new(0.10, 0.0, 0.0),
+            Pose2::new(0.10, 0.0, 0.2),
+        ];
+        let close = |(k, t): (usize, f64), (k2, t2): (usize, f64)| k == k2 && (t - t2).abs() < 1e-9;
+        // 3 cm along: pose 1 is the closest, but the robot is 60 % along the first segment.
+        assert!(close(segment_at(&path, 1, Pose2::new(0.03, 0.0, 0.0)), (0, 0.6)));
+        assert!(close(segment_at(&path, 0, Pose2::new(0.03, 0.0, 0.0)), (0, 0.6)));
+        // 7 cm along, 1 cm aside: 40 % along the second.
+        assert!(close(segment_at(&path, 1, Pose2::new(0.07, 0.01, 0.0)), (1, 0.4)));
+        // Halfway through the turn on the spot, with the last pose the closest.
+        assert!(close(segment_at(&path, 3, Pose2::new(0.10, 0.0, 0.1)), (2, 0.5)));
+        // Past the last pose, and behind the first.
+        assert!(close(segment_at(&path, 3, Pose2::new(0.10, 0.0, 0.3)), (3, 0.0)));
+        assert!(close(segment_at(&path, 0, Pose2::new(-0.02, 0.0, 0.0)), (0, 0.0)));
+        // Either side of the switch of the closest pose, halfway, the same place: the
+        // posture does not jump there.
+        let before = segment_at(&path, 0, Pose2::new(0.0249, 0.0, 0.0));
+        let after = segment_at(&path, 1, Pose2::new(0.0251, 0.0, 0.0));
+        assert_eq!(before.0, after.0);
+        assert!((after.1 - before.1).abs() < 0.01, "{before:?} {after:?}");
     }
 }
