@@ -95,9 +95,9 @@ impl StepExecutor {
     /// `rest` (`planned` on the wheels' rest heights, [`Self::on_wheel_rest_heights`])
     /// with the base's rise moved toward its rise there by at most
     /// `base_rise_speed_mps · dt` since the last tick, the base commanded no more than
-    /// that above or below its last command, and each foot no higher than the driving leg height
-    /// allows under that base ([`Self::leg_slack`]: no leg shorter than the knees fold
-    /// to). Followed at once, a wheel pair driven onto a 3.7 cm box edge at 0.45 m/s
+    /// that above or below its last command, and each foot no higher than the driving leg
+    /// height allows under that base ([`Self::leg_slack`]: no leg shorter than the knees
+    /// fold to). Followed at once, a wheel pair driven onto a 3.7 cm box edge at 0.45 m/s
     /// raised the base at 0.5 m/s, and when the rise stopped the robot flew on: every
     /// wheel off the ground for 60 ms, the CoM 0.25 m outside the support of the wheels
     /// that first came down. A wheel that climbs faster than the base may rise presses
@@ -271,7 +271,9 @@ fn segment_at(path: &[Pose2], progress: usize, base: Pose2) -> (usize, f64) {
 #[cfg(test)]
 mod tests {
     use crate::control::step_executor::StepExecutor;
-    use crate::control::step_executor::test_support::{config, obs, robot, standing, step_path};
+    use crate::control::step_executor::test_support::{
+        config, ground, obs, robot, standing, step_path,
+    };
     use crate::geometry::Pose2;
     use crate::posture::kinematics::Posture;
     use crate::terrain::HeightMap;
@@ -388,8 +390,7 @@ mod tests {
         // (a wheel still on the edge of the box the plan has it off): the command comes
         // down one tick's 1.40 mm, not 3.3 cm less the rise's 1.40 mm. Where the rest
         // heights drop with the plan, it comes down 1.40 mm a tick until it is there.
-        let flat = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |_, _| 0.0).unwrap();
-        let mut ex = StepExecutor::new(&robot(), config(), step_path(), flat);
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
         let step = ex.config.base_rise_speed_mps * 0.01;
         let p = driving();
         let z = p.base_position[2];
@@ -418,8 +419,7 @@ mod tests {
         // planned length), 1 cm after 4 ticks. Balanced loads hold it; the weight on the
         // other diagonal hands it over in 4 ticks; a bounce (a tenth of the weight on the
         // wheels) changes nothing; and nothing lengthens beyond 3 cm.
-        let flat = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |_, _| 0.0).unwrap();
-        let mut ex = StepExecutor::new(&robot(), config(), step_path(), flat);
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
         let p = standing();
         let weight = robot().total_mass * 9.81;
         let mut o = obs(0.0, &ex, &[], [0.0; 3]);
@@ -458,8 +458,7 @@ mod tests {
         // Every leg 1 cm long (a stance compliance's extension carried into the run), the
         // loads balanced: the warp needs nothing, and the shared centimetre goes back at
         // 0.01 m/s, 0.1 mm per tick, keeping the legs equal.
-        let flat = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |_, _| 0.0).unwrap();
-        let mut ex = StepExecutor::new(&robot(), config(), step_path(), flat);
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
         ex.drive_extension = [0.01; 4];
         let p = standing();
         let mut o = obs(0.0, &ex, &[], [0.0; 3]);
@@ -479,8 +478,7 @@ mod tests {
         // tick to the next (a blended turn on the spot that puts a foot on a bump), the
         // rest heights with it: the command rises one tick's 1.40 mm, not 3 cm, and gets
         // there 1.40 mm a tick.
-        let flat = HeightMap::from_fn([-2.0, -2.0], 0.025, 160, 160, |_, _| 0.0).unwrap();
-        let mut ex = StepExecutor::new(&robot(), config(), step_path(), flat);
+        let mut ex = StepExecutor::new(&robot(), config(), step_path(), ground());
         let step = ex.config.base_rise_speed_mps * 0.01;
         let p = driving();
         let z = p.base_position[2];
