@@ -17,11 +17,17 @@
 //! of the diagonal that carries less than that (`control::step_executor`: `drive` in drive
 //! runs, `contact` on four feet while standing).
 
+use crate::robot::Leg;
 use nalgebra::{Matrix3, Vector3};
 
 /// Each leg's sign in the warp, in `Leg` order (front-left, front-right, rear-left,
-/// rear-right): +1 on the front-left/rear-right diagonal, −1 on the other.
-pub const WARP_SIGN: [f64; 4] = [1.0, -1.0, -1.0, 1.0];
+/// rear-right): [`Leg::diagonal_sign`], +1 on the front-left/rear-right diagonal.
+pub const WARP_SIGN: [f64; 4] = [
+    Leg::FrontLeft.diagonal_sign(),
+    Leg::FrontRight.diagonal_sign(),
+    Leg::RearLeft.diagonal_sign(),
+    Leg::RearRight.diagonal_sign(),
+];
 
 /// The warp of measured wheel loads (N, in `Leg` order): `Σ s_i F_i / Σ F_i` with
 /// `s` = [`WARP_SIGN`], in [−1, 1]; `None` when the wheels carry nothing.

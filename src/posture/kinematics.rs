@@ -7,6 +7,11 @@
 //! base tilts the legs' sagittal planes; the contact's lateral offset from the hip plane
 //! (a few millimetres for the rolls used) is taken up by the compliant legs and foam wheels
 //! (Sec. VI-A) and is bounded by [`MAX_LATERAL_MISMATCH_M`] for feet in contact.
+//!
+//! On four feet the offsets' diagonal part, the *stance twist* ([`stance_twist`]), is
+//! bounded apart ([`MAX_STANCE_TWIST_M`]): a roll over feet on different levels asks the
+//! front and rear pairs for different lateral shifts, which no placement of the rigid base
+//! gives and the compliance takes only so far.
 
 use super::CenterOfMassModel;
 use crate::geometry::{Pose2, norm2};
@@ -18,6 +23,32 @@ use serde::Serialize;
 /// Largest lateral offset of a contact point from its hip's sagittal plane accepted for a
 /// foot in contact, m.
 pub const MAX_LATERAL_MISMATCH_M: f64 = 0.03;
+
+/// Largest stance twist ([`stance_twist`]) accepted on four feet in contact, m.
+///
+/// The legs bend only in their own planes, so a base rolled by φ asks each foot for a
+/// lateral shift of its depth below the hip times tan φ. Feet on one level, or on two
+/// levels front and rear (a platform, a flight head-on), ask every leg of a pair the same,
+/// and the base's lateral place and yaw take it up: no twist. One foot on another level
+/// than the other three (a front foot stepped down at an angle to an edge, then its
+/// partner rolled away from it) asks for a twist of a quarter of the level difference times
+/// tan φ: 1.5 cm at 0.3 m and 0.2 rad. In closed loop the base then does not roll (0.05 of
+/// 0.2 rad commanded), pitches over the front wheels instead and unloads the rear ones: six
+/// of 25 generated mixed courses (`generate --seed 1 --count 200`, planned with the wheel
+/// pair's footprint and every manoeuvre) tipped so at 1.4 cm, and passed with rolls held
+/// to 1 cm (1.5 and 2 cm left all six tipping). Steps that need more
+/// roll over such a stance shift the CoM by the other means the generator has (a wheel
+/// toward the centre, a base shift), or are not offered.
+pub const MAX_STANCE_TWIST_M: f64 = 0.01;
+
+/// The stance twist of contact points `local` (each relative to its hip, base frame, `Leg`
+/// order): `Σ s_i y'_i / 4` with `s` = [`Leg::diagonal_sign`], the part of the feet's
+/// lateral offsets from their leg planes that neither the base's lateral place, nor its
+/// yaw, nor an equal change of the two sides' track can remove. Height-free: moving the
+/// base along its own axes shifts every offset alike.
+pub fn stance_twist(local: &[[f64; 3]; 4]) -> f64 {
+    Leg::ALL.iter().map(|l| l.diagonal_sign() * local[l.index()][1]).sum::<f64>() / 4.0
+}
 
 /// Rotation matrix of roll, pitch, yaw (ZYX: R = Rz(yaw)·Ry(pitch)·Rx(roll)), row-major.
 pub fn rotation(rpy: [f64; 3]) -> [[f64; 3]; 3] {
@@ -88,6 +119,12 @@ pub enum PostureError {
     /// The standing rule has no leg height to try.
     #[error("no leg height to try")]
     NoHeight,
+    /// Four feet in contact ask the rigid base for more twist than the legs give.
+    #[error("stance twist {twist:.3} m (at most {MAX_STANCE_TWIST_M} m)")]
+    Twist {
+        /// The stance twist, m ([`stance_twist`]).
+        twist: f64,
+    },
     /// A foot in contact lies too far from its leg's sagittal plane.
     #[error("leg {leg:?}: contact {offset:.3} m off the leg plane")]
     Lateral {
@@ -192,6 +229,19 @@ pub fn hips_in_world(robot: &RobotDescription, p: &Posture) -> [[f64; 3]; 4] {
     std::array::from_fn(|i| apply(&r, p.base_position, robot.hips[i]))
 }
 
+/// [`PostureError::Twist`] when all four feet are in contact and their
+/// [`stance_twist`] passes [`MAX_STANCE_TWIST_M`].
+pub(crate) fn check_stance_twist(
+    contact: [bool; 4],
+    local: &[[f64; 3]; 4],
+) -> Result<(), PostureError> {
+    let twist = stance_twist(local);
+    if contact.iter().all(|&c| c) && twist.abs() > MAX_STANCE_TWIST_M {
+        return Err(PostureError::Twist { twist });
+    }
+    Ok(())
+}
+
 /// Solves the legs of `p`: joint targets (hip, knee, ankle) per leg.
 ///
 /// # Errors
@@ -240,6 +290,7 @@ pub fn solve_chains_in(
     let below = robot.foot_length + robot.wheel_radius;
     let reach = robot.thigh_length + robot.shin_length;
     let mut chains = [LegChain { joints: [0.0; 3], knee: [0.0; 2], ankle: [0.0; 2] }; 4];
+    check_stance_twist(p.contact, &local)?;
     for leg in Leg::ALL {
         let i = leg.index();
         let c = local[i];
@@ -587,6 +638,53 @@ mod tests {
             solve_chains(&robot, &far, 0.002),
             Err(PostureError::ReachMargin { leg: Leg::RearRight, .. })
         ));
+    }
+
+    #[test]
+    fn stance_twist_is_the_diagonal_part_of_the_lateral_offsets() {
+        // Offsets (m) by hand: a base shifted sideways (all alike), turned (front against
+        // rear) or with its track changed (left against right) has no twist; the offsets
+        // of the six tipped mixed courses' rolls, +1.4/−2.9/−0.5/+0.7 cm, have
+        // (1.4 + 2.9 + 0.5 + 0.7) / 4 = 1.375 cm.
+        let at = |y: [f64; 4]| y.map(|y| [0.0, y, -0.5]);
+        for rigid in [[0.02; 4], [0.01, 0.01, -0.01, -0.01], [0.02, -0.02, 0.02, -0.02]] {
+            assert_eq!(stance_twist(&at(rigid)), 0.0, "{rigid:?}");
+        }
+        let tipped = stance_twist(&at([0.014, -0.029, -0.005, 0.007]));
+        assert!((tipped - 0.01375).abs() < 1e-15, "{tipped}");
+        assert!((stance_twist(&at([-0.01, 0.01, 0.01, -0.01])) + 0.01).abs() < 1e-15);
+    }
+
+    #[test]
+    fn four_feet_in_contact_take_a_bounded_twist_three_any() {
+        // Level base, feet 0.45 m under their hips and moved sideways (world y is y'):
+        // front-left out and front-right in by 2.5 cm, each within the 3 cm a single foot
+        // may lie off its leg plane, is a twist of (2.5 + 2.5) / 4 = 1.25 cm: refused on
+        // four feet, accepted with front-right lifted (three feet have no twist), and at
+        // 1.5 cm each (a twist of 0.75 cm) accepted on four.
+        let robot = RobotDescription::reference();
+        let feet = |e: f64| {
+            let mut f = robot.hips.map(|h| [h[0], h[1], h[2] - 0.45]);
+            f[0][1] += e;
+            f[1][1] -= e;
+            f
+        };
+        let p = Posture {
+            base_position: [0.0; 3],
+            base_rpy: [0.0; 3],
+            feet: feet(0.025),
+            contact: [true; 4],
+        };
+        match solve_legs(&robot, &p, 0.002) {
+            Err(PostureError::Twist { twist }) => {
+                assert!((twist - 0.0125).abs() < 1e-12, "{twist}")
+            }
+            other => panic!("{other:?}"),
+        }
+        let lifted = Posture { contact: [true, false, true, true], ..p };
+        assert!(solve_legs(&robot, &lifted, 0.002).is_ok());
+        let small = Posture { feet: feet(0.015), ..p };
+        assert!(solve_legs(&robot, &small, 0.002).is_ok());
     }
 
     #[test]

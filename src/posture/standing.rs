@@ -496,8 +496,10 @@ impl ReachProbe {
 
     /// Whether every leg's hip-to-ankle distance at leg height `h` leaves the reach
     /// margin, and every foot in contact lies on its leg plane (as
-    /// [`super::kinematics::solve_legs`]).
+    /// [`super::kinematics::solve_legs`]), the stance twist within its bound (it does not
+    /// change with `h`: the base moves along its own axis).
     fn distances_ok(&self, h: f64) -> Result<(), PostureError> {
+        super::kinematics::check_stance_twist(self.contact, &self.local0)?;
         let d = self.h0 - h;
         for leg in crate::robot::Leg::ALL {
             let i = leg.index();
@@ -835,7 +837,9 @@ mod tests {
                     let full = solve_legs(&robot, &p, r.reach_margin_m);
                     let geometric = matches!(
                         full,
-                        Err(PostureError::ReachMargin { .. } | PostureError::Lateral { .. })
+                        Err(PostureError::ReachMargin { .. }
+                            | PostureError::Lateral { .. }
+                            | PostureError::Twist { .. })
                     );
                     assert_eq!(probe.distances_ok(h).is_err(), geometric, "{rear_dx} {up} {h}");
                     checked += 1;

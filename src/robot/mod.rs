@@ -52,6 +52,17 @@ impl Leg {
         matches!(self, Leg::FrontLeft | Leg::RearLeft)
     }
 
+    /// The leg's sign on the diagonals: +1 on front-left/rear-right, −1 on the other.
+    /// A pattern of four values (loads, lateral offsets) weighted by it sums what one
+    /// diagonal has beyond the other, the *warp* of a four-foot stance; no rigid motion
+    /// of the base in the plane and no equal change of the legs of one side adds to it.
+    pub const fn diagonal_sign(self) -> f64 {
+        match self {
+            Leg::FrontLeft | Leg::RearRight => 1.0,
+            Leg::FrontRight | Leg::RearLeft => -1.0,
+        }
+    }
+
     /// The other leg on the same side.
     pub const fn same_side_partner(self) -> Leg {
         match self {
