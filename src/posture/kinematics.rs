@@ -36,9 +36,9 @@ pub const MAX_LATERAL_MISMATCH_M: f64 = 0.03;
 /// 0.2 rad commanded), pitches over the front wheels instead and unloads the rear ones: six
 /// of 25 generated mixed courses (`generate --seed 1 --count 200`, planned with the wheel
 /// pair's footprint and every manoeuvre) tipped so at 1.4 cm, and passed with rolls held
-/// to 1 cm (1.5 and 2 cm left all six tipping). Steps that need more
-/// roll over such a stance shift the CoM by the other means the generator has (a wheel
-/// toward the centre, a base shift), or are not offered.
+/// to 1 cm (1.5 and 2 cm left all six tipping). Steps that need more roll over such a
+/// stance shift the CoM by the other means the generator has (a wheel toward the centre,
+/// a base shift), or are not offered.
 pub const MAX_STANCE_TWIST_M: f64 = 0.01;
 
 /// The stance twist of contact points `local` (each relative to its hip, base frame, `Leg`
@@ -235,9 +235,11 @@ pub(crate) fn check_stance_twist(
     contact: [bool; 4],
     local: &[[f64; 3]; 4],
 ) -> Result<(), PostureError> {
-    let twist = stance_twist(local);
-    if contact.iter().all(|&c| c) && twist.abs() > MAX_STANCE_TWIST_M {
-        return Err(PostureError::Twist { twist });
+    if contact.iter().all(|&c| c) {
+        let twist = stance_twist(local);
+        if twist.abs() > MAX_STANCE_TWIST_M {
+            return Err(PostureError::Twist { twist });
+        }
     }
     Ok(())
 }
@@ -286,11 +288,11 @@ pub fn solve_chains_in(
         p.base_rpy
     );
     let local = contacts_in(robot, &frame.rotation, p);
+    check_stance_twist(p.contact, &local)?;
     let pitch = frame.rpy[1];
     let below = robot.foot_length + robot.wheel_radius;
     let reach = robot.thigh_length + robot.shin_length;
     let mut chains = [LegChain { joints: [0.0; 3], knee: [0.0; 2], ankle: [0.0; 2] }; 4];
-    check_stance_twist(p.contact, &local)?;
     for leg in Leg::ALL {
         let i = leg.index();
         let c = local[i];

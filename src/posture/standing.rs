@@ -420,6 +420,9 @@ struct ReachProbe {
     limit: f64,
     reach_margin: f64,
     contact: [bool; 4],
+    /// The stance twist's verdict ([`super::kinematics::check_stance_twist`]): the base
+    /// moves along its own axis, so it is the same at every height.
+    twist: Result<(), PostureError>,
 }
 
 impl ReachProbe {
@@ -436,8 +439,10 @@ impl ReachProbe {
         let p = level_posture_in(robot, *feet, contact, xy, frame, h0, *ground);
         let (r, down) = (&frame.rotation, frame.down);
         let below = robot.foot_length + robot.wheel_radius;
+        let local0 = contacts_in(robot, r, &p);
         Self {
-            local0: contacts_in(robot, r, &p),
+            twist: super::kinematics::check_stance_twist(contact, &local0),
+            local0,
             up: [r[2][0], r[2][1], r[2][2]],
             h0,
             ankle: [-below * down[0], -below * down[1]],
@@ -496,10 +501,9 @@ impl ReachProbe {
 
     /// Whether every leg's hip-to-ankle distance at leg height `h` leaves the reach
     /// margin, and every foot in contact lies on its leg plane (as
-    /// [`super::kinematics::solve_legs`]), the stance twist within its bound (it does not
-    /// change with `h`: the base moves along its own axis).
+    /// [`super::kinematics::solve_legs`]), the stance twist within its bound.
     fn distances_ok(&self, h: f64) -> Result<(), PostureError> {
-        super::kinematics::check_stance_twist(self.contact, &self.local0)?;
+        self.twist.clone()?;
         let d = self.h0 - h;
         for leg in crate::robot::Leg::ALL {
             let i = leg.index();
