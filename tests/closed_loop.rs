@@ -127,7 +127,8 @@ fn a_plan_whose_base_drops_at_an_edge_keeps_the_wheels_loaded() {
 fn a_roll_over_a_foot_stepped_down_at_an_angle_keeps_the_robot_up() {
     use momaro::params::{FootModel, StepModel};
     let mut sc = common::generated(momaro::scenario::generate::Class::Mixed, 31);
-    (sc.params.foot_model, sc.params.step_model) = (FootModel::WheelPair, StepModel::Stairs);
+    sc.set_foot_model(FootModel::WheelPair);
+    sc.set_step_model(StepModel::Stairs);
     let s = run(&sc, &RunOptions::new(common::first_solution(), common::model()))
         .expect("run completes");
     assert!(s.passed && !s.tipped, "{s:#?}");

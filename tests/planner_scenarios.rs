@@ -224,7 +224,7 @@ fn flights_longer_than_the_robot_need_the_stairs_step_model() {
     let p = plan(&s, &first_solution());
     check_solutions(&p);
     assert!(steps(&p).len() >= 16, "every foot climbs four steps");
-    s.params.step_model = StepModel::Paper;
+    s.set_step_model(StepModel::Paper);
     s.map.x_max = 2.7; // a smaller map, the goal on the landing: the search ends sooner
     s.goal.x = 2.0;
     match run(&s, &robot(), &first_solution(), &ALL) {
@@ -241,7 +241,7 @@ fn flights_longer_than_the_robot_need_the_stairs_step_model() {
         ("stairs_descent", StepModel::Stairs),
     ] {
         let mut s = scenario(name);
-        s.params.step_model = model;
+        s.set_step_model(model);
         let p = plan(&s, &first_solution());
         check_solutions(&p);
         assert!(steps(&p).len() >= 12, "{name}, {model:?}: every foot climbs three steps");
@@ -249,23 +249,38 @@ fn flights_longer_than_the_robot_need_the_stairs_step_model() {
 }
 
 #[test]
-fn stairs_written_without_models_get_the_ones_that_climb_them() {
+fn stairs_written_without_models_get_the_ones_that_climb_them_as_flights_or_boxes() {
     // Building-code flights as a user writes them, naming no models: three steps (the
     // paper's r_F disc leaves 5 cm of each 0.29 m tread, and the search had no path) and
-    // six (the paper's manoeuvres cannot climb a flight longer than the robot).
+    // six (the paper's manoeuvres cannot climb a flight longer than the robot). The
+    // planner reads the models off the heights, so the same flights written as a box per
+    // step (the same heights cell for cell, no label) get the same plan, step for step,
+    // at the same cost and expansions.
     let probe = probe_path();
     for (name, step_model, climbed) in
         [("stairs_indoor", StepModel::Paper, 12), ("stairs_long", StepModel::Stairs, 24)]
     {
         let path = scenario_path(name);
         let text = std::fs::read_to_string(&path).expect("scenario");
-        let (head, tail) = text.split_once("[params]").expect("the file names its models");
-        let unnamed = format!("{head}{}", &tail[tail.find("[expect]").expect("expect")..]);
-        let s = Scenario::parse(&unnamed, &path).expect("parses without [params]");
-        assert_eq!((s.params.foot_model, s.params.step_model), (FootModel::WheelPair, step_model));
-        let p = plan(&s, &probe);
-        check_solutions(&p);
-        assert!(steps(&p).len() >= climbed, "{name}: every foot climbs the flight");
+        let unnamed = match text.split_once("[params]") {
+            Some((head, tail)) => {
+                format!("{head}{}", &tail[tail.find("[expect]").expect("[expect]")..])
+            }
+            None => text.clone(),
+        };
+        let labelled = Scenario::parse(&unnamed, &path).expect("parses without [params]");
+        assert_eq!(labelled.named_models, Default::default(), "{name}");
+        let mut boxes = labelled.clone();
+        boxes.terrain = labelled.terrain.iter().flat_map(|p| p.as_boxes()).collect();
+        assert!(boxes.terrain.iter().all(|p| p.kind() == "box"), "{name}: boxes");
+        let (a, b) = (plan(&labelled, &probe), plan(&boxes, &probe));
+        for p in [&a, &b] {
+            assert_eq!((p.foot_model, p.step_model), (FootModel::WheelPair, step_model), "{name}");
+            check_solutions(p);
+            assert!(steps(p).len() >= climbed, "{name}: every foot climbs the flight");
+        }
+        assert_eq!((a.cost, a.expansions), (b.cost, b.expansions), "{name}");
+        assert_eq!(a.path, b.path, "{name}");
     }
 }
 

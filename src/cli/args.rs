@@ -407,15 +407,16 @@ pub struct PlannerArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub step_cost_factor: Option<f64>,
     /// Foot model of the foot cost, for experiments (default: the scenario's `[params]
-    /// foot_model`, else `wheel_pair`, the wheel pair's contact footprint at the foot's
-    /// heading, on courses with a `stairs` primitive and `paper`, the paper's disc of
-    /// radius r_F (eq. 2), elsewhere: `scenario::default_models`).
+    /// foot_model`, else chosen from the height map: `wheel_pair`, the wheel pair's
+    /// contact footprint at the foot's heading, where it has a flight of steps, and
+    /// `paper`, the paper's disc of radius r_F (eq. 2), elsewhere;
+    /// `planner::terrain_models`).
     #[arg(long, value_enum)]
     pub foot_model: Option<FootModelArg>,
     /// Which manoeuvres prepare steps, for experiments (default: the scenario's `[params]
-    /// step_model`, else `stairs`, every manoeuvre where the terrain calls for it, on
-    /// courses with a flight of four or more steps and `paper`, the paper's manoeuvres
-    /// alone, elsewhere: `scenario::default_models`).
+    /// step_model`, else chosen from the height map: `stairs`, every manoeuvre where the
+    /// terrain calls for it, where it has a flight of four or more steps, and `paper`, the
+    /// paper's manoeuvres alone, elsewhere; `planner::terrain_models`).
     #[arg(long, value_enum)]
     pub step_model: Option<StepModelArg>,
 }

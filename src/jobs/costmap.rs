@@ -162,7 +162,9 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
     let height_map_time_s = t.elapsed().as_secs_f64();
     let robot = Simulation::robot_only(&opts.model_path)?.robot().clone();
     let t = Instant::now();
-    let maps = CostMaps::build(&heights, &robot, &scenario.params)?;
+    // The models the planner would choose on this map (the sensed one with --sensed).
+    let params = crate::planner::scenario_params(scenario, &robot, &heights);
+    let maps = CostMaps::build(&heights, &robot, &params)?;
     let cost_maps_time_s = t.elapsed().as_secs_f64();
 
     let theta = scenario.start.theta;

@@ -36,7 +36,13 @@ pub fn record(
     path: &Path,
 ) -> Result<(), PlanRecordingError> {
     let heights = rasterised_map(scenario)?;
-    let maps = CostMaps::build(&heights, robot, &scenario.params)?;
+    // The models the plan was made with.
+    let params = crate::params::Params {
+        foot_model: summary.foot_model,
+        step_model: summary.step_model,
+        ..scenario.params.clone()
+    };
+    let maps = CostMaps::build(&heights, robot, &params)?;
     let rec = Recorder::create(path, "momaro plan")?;
     rec.log_height_map(&heights)?;
     let (nx, ny) = heights.dims();

@@ -48,4 +48,7 @@ pub use lattice::{Lattice, LatticeError, LatticeState, Move, NEUTRAL_FOOTPRINT, 
 pub use options::{ParamOverrides, PlanError, PlanOptions};
 pub use orientation::OrientationFactor;
 pub use plan::{PlanSummary, run, run_on};
-pub use world::{Prepared, nearest_start, prepare, prepare_for};
+pub use world::{
+    PAPER_MODEL_FLIGHT_STEPS, Prepared, flight_rule, nearest_start, params_for, prepare,
+    prepare_for, scenario_heights, scenario_params, terrain_models,
+};

@@ -17,18 +17,21 @@
 
 use super::graph::ManoeuvreSet;
 use super::options::{ParamOverrides, PlanError, PlanOptions, bad, check_options};
-use super::world::{MapInfo, Prepared, params_for, prepare_for};
+use super::world::{
+    MapInfo, PAPER_MODEL_FLIGHT_STEPS, Prepared, flight_rule, params_for, prepare_for,
+};
 use super::{HybridGraph, LatticeState, ManoeuvreStats, Neighbourhood, PoseKey};
 use crate::params::{FootModel, StepModel};
 use crate::path::{ManoeuvreKind, PathElement};
 use crate::robot::RobotDescription;
-use crate::scenario::{PAPER_MODEL_FLIGHT_STEPS, Scenario, longest_flight};
+use crate::scenario::Scenario;
 use crate::search::Algorithm;
 use crate::search::{
     Cost, ExpandHook, Expansion, Hooks, SearchError, SearchParams, SearchResult, Termination,
     arastar_with_hooks, astar_with_hooks,
 };
 use crate::terrain::HeightMap;
+use crate::terrain::longest_flight;
 use serde::Serialize;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
@@ -268,7 +271,7 @@ pub fn run_on_counted(
     counts: Option<&mut Option<ExpansionCounts>>,
 ) -> Result<PlanSummary, PlanError> {
     let limit = check_options(opts)?;
-    let params = params_for(scenario, opts.overrides)?;
+    let params = params_for(scenario, robot, prep.maps.heights(), opts.overrides)?;
     if params != prep.params {
         return Err(bad(
             "prepared",
@@ -278,17 +281,19 @@ pub fn run_on_counted(
     search_prepared(prep, scenario, robot, opts, (Instant::now(), limit), counts)
 }
 
-/// What a "no path" adds for a scenario planned with the paper's step model whose
-/// terrain has a flight of [`PAPER_MODEL_FLIGHT_STEPS`] or more: the models that climb
-/// it. Empty otherwise.
-fn stairs_model_hint(scenario: &Scenario, step_model: StepModel) -> String {
-    match longest_flight(&scenario.terrain) {
-        Some(n) if step_model == StepModel::Paper && n >= PAPER_MODEL_FLIGHT_STEPS => format!(
-            "; its stairs have {n} steps, and with step_model = \"paper\" flights of \
-             {PAPER_MODEL_FLIGHT_STEPS} or more have no path: set step_model = \"stairs\" \
-             and foot_model = \"wheel_pair\" in its [params] (README, \"Step model\")"
-        ),
-        _ => String::new(),
+/// What a "no path" adds for a plan with the paper's step model (named in the file or
+/// asked for) on a height map with a flight of [`PAPER_MODEL_FLIGHT_STEPS`] risers or
+/// more: the models that climb it. Empty otherwise.
+fn stairs_model_hint(prep: &Prepared, robot: &RobotDescription) -> String {
+    let n = longest_flight(prep.maps.heights(), &flight_rule(robot, &prep.params));
+    if prep.params.step_model == StepModel::Paper && n >= PAPER_MODEL_FLIGHT_STEPS {
+        format!(
+            "; its height map has a flight of {n} steps, and with step_model = \"paper\" \
+             flights of {PAPER_MODEL_FLIGHT_STEPS} or more have no path: set step_model = \
+             \"stairs\" and foot_model = \"wheel_pair\" (docs/models.md)"
+        )
+    } else {
+        String::new()
     }
 }
 
@@ -359,7 +364,7 @@ fn search_prepared(
             ),
             t => format!("the search stopped ({})", termination_name(t)),
         };
-        let reason = reason + &stairs_model_hint(scenario, prep.params.step_model);
+        let reason = reason + &stairs_model_hint(prep, robot);
         return Err(PlanError::NoPath {
             scenario: file(),
             termination: result.termination,
@@ -518,26 +523,32 @@ mod tests {
 
     #[test]
     fn a_long_flight_planned_with_the_paper_step_model_is_told_the_stairs_models() {
-        // The repository's six-step flight names the stairs models; without them (or with
-        // the paper's) a "no path" says which to set, and so does a four-step flight; a
-        // three-step one (which the paper's model climbs) and the stairs model get none.
+        // The repository's six-step flight, its models chosen from its heights: the stairs
+        // model gets no hint; the paper's (asked for) is told which to set, and so is a
+        // four-step flight; a three-step one (which the paper's model climbs) gets none.
         use crate::params::StepModel;
+        use crate::planner::{ParamOverrides, prepare};
+        let robot = crate::robot::RobotDescription::reference();
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/stairs_long.toml");
         let text = std::fs::read_to_string(&path).unwrap();
-        let sc = crate::scenario::Scenario::parse(&text, &path).unwrap();
-        assert_eq!(super::stairs_model_hint(&sc, StepModel::Stairs), "");
-        let hint = super::stairs_model_hint(&sc, StepModel::Paper);
+        let hint = |text: &str, step_model| {
+            let sc = crate::scenario::Scenario::parse(text, &path).unwrap();
+            let overrides = ParamOverrides { step_model, ..ParamOverrides::default() };
+            let prep = prepare(&sc, &robot, overrides, &crate::motion::manoeuvres::ALL).unwrap();
+            super::stairs_model_hint(&prep, &robot)
+        };
+        assert_eq!(hint(&text, None), "");
+        let said = hint(&text, Some(StepModel::Paper));
         assert!(
-            hint.starts_with("; its stairs have 6 steps")
-                && hint.contains("step_model = \"stairs\"")
-                && hint.contains("foot_model = \"wheel_pair\""),
-            "{hint}"
+            said.starts_with("; its height map has a flight of 6 steps")
+                && said.contains("step_model = \"stairs\"")
+                && said.contains("foot_model = \"wheel_pair\""),
+            "{said}"
         );
         for (steps, hinted) in [(4, true), (3, false)] {
             let t = text.replace("steps = 6", &format!("steps = {steps}"));
-            let sc = crate::scenario::Scenario::parse(&t, &path).unwrap();
-            assert_eq!(!super::stairs_model_hint(&sc, StepModel::Paper).is_empty(), hinted);
+            assert_eq!(!hint(&t, Some(StepModel::Paper)).is_empty(), hinted, "{steps} steps");
         }
     }
 }

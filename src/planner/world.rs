@@ -13,10 +13,10 @@ use super::{
 };
 use crate::cost::{Cost as CostValue, CostMaps};
 use crate::geometry::Pose2;
-use crate::params::Params;
+use crate::params::{FootModel, Params, StepModel};
 use crate::robot::RobotDescription;
 use crate::scenario::Scenario;
-use crate::terrain::rasterise;
+use crate::terrain::{FlightRule, HeightMap, longest_flight, rasterise};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -122,8 +122,9 @@ pub fn prepare(
     manoeuvres: &'static dyn ManoeuvreSet,
 ) -> Result<Prepared, PlanError> {
     let t0 = Instant::now();
-    let params = params_for(scenario, overrides)?;
-    let (maps, lattice) = build_maps(scenario, robot, &params)?;
+    let heights = scenario_heights(scenario)?;
+    let params = params_for(scenario, robot, &heights, overrides)?;
+    let (maps, lattice) = build_maps(scenario, robot, &params, &heights)?;
     let endpoint = |which, pose| endpoint(scenario, robot, &params, (&maps, &lattice), which, pose);
     let start = endpoint("start", scenario.start)?;
     let goal = endpoint("goal", scenario.goal)?;
@@ -177,34 +178,117 @@ pub(crate) fn endpoint(
     Ok(s)
 }
 
-/// The scenario's parameters with the options' overrides, validated.
-pub(crate) fn params_for(
+/// Flights of this many steps or more have no path with the paper's step model: its
+/// front feet never stand behind neutral, so the feet of one side stay a hip spacing
+/// (0.7 m) apart, and on a flight longer than the robot's 0.8 m feet span no footprint
+/// lets a rear foot step while the front feet stand on a tread (`docs/models.md`). Where
+/// the height map has such a flight, the stairs manoeuvres are chosen
+/// ([`terrain_models`]).
+pub const PAPER_MODEL_FLIGHT_STEPS: u32 = 4;
+
+/// What a flight is for `robot` under `params` (`terrain::flights`): a riser is a height
+/// change a wheel cannot drive over (ΔH_max, eq. 2) up to what a step overcomes (Sec. V);
+/// changes closer than a wheel radius are one riser (no wheel stands between them); a
+/// tread is too short for the whole robot when it is shorter than the wheels of the
+/// neutral footprint from front to back (so the feet stand on different levels), and a
+/// flight is at least as wide as those wheels from side to side (a narrower one the robot
+/// cannot climb, and two small blocks stacked are clutter).
+pub fn flight_rule(robot: &RobotDescription, params: &Params) -> FlightRule {
+    let feet = robot.neutral_footprint();
+    let extent = |axis: usize| {
+        let v = feet.map(|f| f[axis]);
+        v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - v.iter().copied().fold(f64::INFINITY, f64::min)
+    };
+    FlightRule {
+        min_rise_m: params.max_foot_height_diff_m,
+        max_rise_m: params.max_step_height_m,
+        min_tread_m: robot.wheel_radius,
+        max_tread_m: extent(0) + 2.0 * robot.wheel_radius,
+        min_width_m: extent(1) + robot.wheel_track,
+    }
+}
+
+/// The planner's models for terrain `heights` (issue 63), chosen from heights and the
+/// robot alone: on a flight of steps ([`flight_rule`]) the wheel pair's contact footprint
+/// (the paper's r_F disc leaves 5 cm of foothold on a 0.29 m tread, less than the robot's
+/// 16 cm wheels stand on), and the stairs manoeuvres from [`PAPER_MODEL_FLIGHT_STEPS`]
+/// risers on; elsewhere the paper's models (beside walls the wheel pair needs 2 cm more
+/// than the disc, and doorways that the robot drove through it stepped through).
+pub fn terrain_models(
+    heights: &HeightMap,
+    robot: &RobotDescription,
+    params: &Params,
+) -> (FootModel, StepModel) {
+    match longest_flight(heights, &flight_rule(robot, params)) {
+        0 | 1 => (FootModel::Paper, StepModel::Paper),
+        n if n >= PAPER_MODEL_FLIGHT_STEPS => (FootModel::WheelPair, StepModel::Stairs),
+        _ => (FootModel::WheelPair, StepModel::Paper),
+    }
+}
+
+/// The scenario's parameters on `heights`: the models its file does not name chosen
+/// from the terrain ([`terrain_models`]).
+pub fn scenario_params(
     scenario: &Scenario,
+    robot: &RobotDescription,
+    heights: &HeightMap,
+) -> Params {
+    let mut params = scenario.params.clone();
+    let named = scenario.named_models;
+    if !(named.foot && named.step) {
+        let (foot, step) = terrain_models(heights, robot, &params);
+        if !named.foot {
+            params.foot_model = foot;
+        }
+        if !named.step {
+            params.step_model = step;
+        }
+    }
+    params
+}
+
+/// [`scenario_params`] with the options' overrides, validated.
+///
+/// # Errors
+/// [`PlanError::Params`] naming the scenario.
+pub fn params_for(
+    scenario: &Scenario,
+    robot: &RobotDescription,
+    heights: &HeightMap,
     overrides: ParamOverrides,
 ) -> Result<Params, PlanError> {
-    let params = overrides.apply(scenario.params.clone());
+    let params = overrides.apply(scenario_params(scenario, robot, heights));
     params
         .validate()
         .map_err(|source| PlanError::Params { scenario: scenario.path.clone(), source })?;
     Ok(params)
 }
 
-/// The height and cost maps of `scenario` with `params`, and the lattice over them.
+/// The height map of `scenario`, rasterised at its grid resolution.
+///
+/// # Errors
+/// [`PlanError::Map`] naming the scenario.
+pub fn scenario_heights(scenario: &Scenario) -> Result<HeightMap, PlanError> {
+    let m = &scenario.map;
+    rasterise(
+        &scenario.terrain,
+        [m.x_min, m.y_min],
+        [m.x_max - m.x_min, m.y_max - m.y_min],
+        scenario.params.grid_resolution_m,
+    )
+    .map_err(|source| PlanError::Map { scenario: scenario.path.clone(), source })
+}
+
+/// The cost maps of `scenario`'s `heights` with `params`, and the lattice over them.
 fn build_maps(
     scenario: &Scenario,
     robot: &RobotDescription,
     params: &Params,
+    heights: &HeightMap,
 ) -> Result<(CostMaps, crate::planner::Lattice), PlanError> {
     let file = || scenario.path.clone();
-    let m = &scenario.map;
-    let heights = rasterise(
-        &scenario.terrain,
-        [m.x_min, m.y_min],
-        [m.x_max - m.x_min, m.y_max - m.y_min],
-        params.grid_resolution_m,
-    )
-    .map_err(|source| PlanError::Map { scenario: file(), source })?;
-    let maps = CostMaps::build(&heights, robot, params)
+    let maps = CostMaps::build(heights, robot, params)
         .map_err(|source| PlanError::Cost { scenario: file(), source })?;
     let lattice = crate::planner::Lattice::for_map(maps.heights(), params.orientations)
         .map_err(|source| PlanError::Lattice { scenario: file(), source })?;

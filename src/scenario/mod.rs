@@ -7,15 +7,11 @@
 //! rasterised height map (`terrain`).
 //!
 //! **Models a file does not name.** `[params]` may name `foot_model` and `step_model`;
-//! where it does not and the terrain has a flight of stairs, the scenario takes the models
-//! that climb stairs rather than [`Params`]' defaults, which are the paper's
-//! ([`default_models`]): the wheel pair's own contact footprint (the paper's r_F disc
-//! leaves 5 cm of foothold on a 0.29 m tread, less than the robot's 16 cm wheels stand on,
-//! and a three-step indoor flight had no path), and from [`PAPER_MODEL_FLIGHT_STEPS`]
-//! steps on the stairs manoeuvres, without which no flight longer than the robot is
-//! climbed. Terrain without stairs keeps the paper's models: beside walls the wheel pair
-//! needs 2 cm more than the disc, and doorways that the robot drove through it stepped
-//! through. A file that names a model gets it.
+//! the models it leaves out ([`NamedModels`]) are chosen when the planner's world is
+//! prepared, from the height map and the robot alone (`planner::world::terrain_models`):
+//! a flight of steps gets the models that climb it whether it is written as a `stairs`
+//! primitive, as stacked boxes or seen by a laser. Until then [`Scenario::params`] holds
+//! [`Params`]' defaults (the paper's) for them.
 
 mod field;
 pub mod generate;
@@ -170,13 +166,6 @@ pub const DEFAULT_MAX_STATIC_VIOLATION_S: f64 = 0.1;
 /// abort in an allocation.
 pub const MAX_MAP_CELLS: f64 = 4.0e6;
 
-/// Flights of this many steps or more have no path with the paper's step model: its
-/// front feet never stand behind neutral, so the feet of one side stay a hip spacing
-/// (0.7 m) apart, and on a flight longer than the robot's 0.8 m feet span no footprint
-/// lets a rear foot step while the front feet stand on a tread (README, "Step model").
-/// A scenario that names no step model gets `stairs` for them ([`default_models`]).
-pub const PAPER_MODEL_FLIGHT_STEPS: u32 = 4;
-
 /// The file format, exactly as written.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -196,9 +185,9 @@ struct ScenarioFile {
     expect: Expectations,
 }
 
-/// Which models a file's `[params]` names (the rest of the file is [`ScenarioFile`]'s).
+/// The model keys of a file's `[params]` (the rest of the file is [`ScenarioFile`]'s).
 #[derive(Debug, Default, Deserialize)]
-struct NamedModels {
+struct ModelKeys {
     #[serde(default)]
     params: NamedModelKeys,
 }
@@ -210,20 +199,14 @@ struct NamedModelKeys {
     step_model: Option<toml::Value>,
 }
 
-/// The models of a scenario whose file names none (module docs): on terrain with a
-/// flight of stairs the wheel pair's footprint, and the stairs manoeuvres from a flight of
-/// [`PAPER_MODEL_FLIGHT_STEPS`] steps on; elsewhere the paper's.
-pub fn default_models(terrain: &[Primitive]) -> (FootModel, StepModel) {
-    match longest_flight(terrain) {
-        None => (FootModel::Paper, StepModel::Paper),
-        Some(n) if n >= PAPER_MODEL_FLIGHT_STEPS => (FootModel::WheelPair, StepModel::Stairs),
-        Some(_) => (FootModel::WheelPair, StepModel::Paper),
-    }
-}
-
-/// The most steps of any `stairs` primitive of `terrain`; `None` without stairs.
-pub fn longest_flight(terrain: &[Primitive]) -> Option<u32> {
-    terrain.iter().filter_map(Primitive::flight_steps).max()
+/// Which of the planner's models a scenario file names in `[params]`; the planner
+/// chooses the others from the terrain's height map (module docs).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct NamedModels {
+    /// `foot_model` is named.
+    pub foot: bool,
+    /// `step_model` is named.
+    pub step: bool,
 }
 
 /// A loaded, validated scenario.
@@ -248,11 +231,28 @@ pub struct Scenario {
     pub terrain: Vec<Primitive>,
     /// The paper's parameters with this scenario's overrides.
     pub params: Params,
+    /// Which models `params` holds because the file names them (set them with
+    /// [`Self::set_foot_model`] and [`Self::set_step_model`]: a model written into
+    /// `params` alone is replaced by the terrain's).
+    pub named_models: NamedModels,
     /// What a run must show.
     pub expect: Expectations,
 }
 
 impl Scenario {
+    /// Plans with foot model `model`, as if the file named it (the planner then does not
+    /// choose one from the terrain).
+    pub fn set_foot_model(&mut self, model: FootModel) {
+        self.params.foot_model = model;
+        self.named_models.foot = true;
+    }
+
+    /// Plans with step model `model`, as if the file named it.
+    pub fn set_step_model(&mut self, model: StepModel) {
+        self.params.step_model = model;
+        self.named_models.step = true;
+    }
+
     /// Reads and validates a scenario file.
     ///
     /// # Errors
@@ -279,15 +279,11 @@ impl Scenario {
         };
         validate(&file).map_err(|(field, reason)| invalid(&field, reason))?;
         // The same text parsed above, so this cannot fail where that did not.
-        let named: NamedModels = toml::from_str(text).unwrap_or_default();
-        let mut params = file.params;
-        let (foot, step) = default_models(&file.terrain);
-        if named.params.foot_model.is_none() {
-            params.foot_model = foot;
-        }
-        if named.params.step_model.is_none() {
-            params.step_model = step;
-        }
+        let keys: ModelKeys = toml::from_str(text).unwrap_or_default();
+        let named_models = NamedModels {
+            foot: keys.params.foot_model.is_some(),
+            step: keys.params.step_model.is_some(),
+        };
         let name = file.name.clone().unwrap_or_else(|| {
             path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
         });
@@ -300,7 +296,8 @@ impl Scenario {
             start: file.start.pose(),
             goal: file.goal.pose(),
             terrain: file.terrain,
-            params,
+            params: file.params,
+            named_models,
             expect: file.expect,
         })
     }
@@ -496,40 +493,30 @@ mod tests {
     }
 
     #[test]
-    fn models_a_file_does_not_name_fit_its_terrain() {
-        // `Params` keeps the paper's, and so does terrain without stairs; a flight in a
-        // file naming no model gets the wheel pair, and the stairs manoeuvres from four
-        // steps on; a named model is kept.
-        assert_eq!(
-            (Params::default().foot_model, Params::default().step_model),
-            (FootModel::Paper, StepModel::Paper)
-        );
-        let flight = |steps: u32, params: &str| {
+    fn a_file_s_named_models_are_kept_and_the_others_left_to_the_terrain() {
+        // Unnamed models keep `Params`' (the paper's) until the planner reads the height
+        // map; a stairs primitive does not choose them.
+        let flight = |params: &str| {
             let stairs = format!(
                 "[[terrain]]\nkind = \"stairs\"\nstart = [1.0, -1.4]\nwidth = 0.8\n\
-                 steps = {steps}\nstep_depth = 0.29\nstep_height = 0.17\n[params]\n{params}"
+                 steps = 6\nstep_depth = 0.29\nstep_height = 0.17\n[params]\n{params}"
             );
             let s = parse(&GOOD.replace("[params]", &stairs)).unwrap();
-            (s.params.foot_model, s.params.step_model)
+            (s.params.foot_model, s.params.step_model, s.named_models)
         };
-        let (wheels, paper, stairs) = (FootModel::WheelPair, StepModel::Paper, StepModel::Stairs);
-        assert_eq!(flight(3, ""), (wheels, paper));
-        assert_eq!(flight(PAPER_MODEL_FLIGHT_STEPS, ""), (wheels, stairs));
-        assert_eq!(flight(12, ""), (wheels, stairs));
-        assert_eq!(flight(6, "step_model = \"paper\""), (wheels, paper));
-        assert_eq!(flight(2, "step_model = \"stairs\""), (wheels, stairs));
-        assert_eq!(flight(6, "foot_model = \"paper\""), (FootModel::Paper, stairs));
-        // Terrain without stairs, and a file without a [params] table at all.
-        let bare = GOOD.split("[params]").next().unwrap();
-        let s = parse(bare).unwrap();
-        assert_eq!((s.params.foot_model, s.params.step_model), (FootModel::Paper, paper));
-        let bare = bare.replace(
-            "[[terrain]]",
-            "[[terrain]]\nkind = \"stairs\"\nstart = [1.0, -1.4]\nwidth = 0.8\nsteps = 5\n\
-             step_depth = 0.29\nstep_height = 0.17\n[[terrain]]",
+        let named = |foot, step| NamedModels { foot, step };
+        let (paper_foot, paper) = (FootModel::Paper, StepModel::Paper);
+        assert_eq!(flight(""), (paper_foot, paper, named(false, false)));
+        assert_eq!(
+            flight("step_model = \"stairs\""),
+            (paper_foot, StepModel::Stairs, named(false, true))
         );
-        let s = parse(&bare).unwrap();
-        assert_eq!((s.params.foot_model, s.params.step_model), (wheels, stairs));
+        assert_eq!(
+            flight("foot_model = \"wheel_pair\"\nstep_model = \"paper\""),
+            (FootModel::WheelPair, paper, named(true, true))
+        );
+        let bare = GOOD.split("[params]").next().unwrap();
+        assert_eq!(parse(bare).unwrap().named_models, named(false, false));
     }
 
     #[test]

@@ -192,10 +192,10 @@ mod tests {
     /// The scenario a case describes, built from its fields rather than from its file.
     fn expected(c: &GeneratedCase) -> Scenario {
         let terrain: Vec<Primitive> = c.terrain.iter().map(|p| p.primitive.clone()).collect();
-        let (foot_model, step_model) = match c.class.models() {
-            Some((step, foot)) => (foot, step),
-            None => crate::scenario::default_models(&terrain),
-        };
+        let named = c.class.models();
+        let defaults = Params::default();
+        let (foot_model, step_model) =
+            named.map_or((defaults.foot_model, defaults.step_model), |(step, foot)| (foot, step));
         Scenario {
             name: c.name.clone(),
             path: Path::new("gen").join(c.file_name()),
@@ -205,7 +205,11 @@ mod tests {
             start: c.start.pose(),
             goal: c.goal.pose(),
             terrain,
-            params: Params { foot_model, step_model, ..Params::default() },
+            params: Params { foot_model, step_model, ..defaults },
+            named_models: crate::scenario::NamedModels {
+                foot: named.is_some(),
+                step: named.is_some(),
+            },
             expect: c.expectations(),
         }
     }

@@ -154,9 +154,9 @@ impl Class {
     }
 
     /// The step and foot models the class's files name in `[params]`, if any (only
-    /// stairs do: see `stairs.rs`). The other classes name none and get the scenario's
-    /// defaults for their terrain (`scenario::default_models`): mixed courses whose climb
-    /// is 2–3 steps get the wheel pair, the rest the paper's models.
+    /// stairs do: see `stairs.rs`). The other classes name none and the planner chooses
+    /// them from the course's heights (`planner::terrain_models`): mixed courses whose
+    /// climb is 2–3 steps get the wheel pair, the rest the paper's models.
     pub fn models(self) -> Option<(StepModel, FootModel)> {
         self.unit().models
     }
@@ -430,14 +430,16 @@ mod tests {
                     assert_eq!(s.expect.min_stability_margin_m, 0.02);
                 }
                 assert!(s.map.contains(s.start.x, s.start.y) && s.map.contains(s.goal.x, s.goal.y));
-                // Stairs ask for the models that climb treads shorter than the robot; the
-                // other classes name none and get the defaults for their terrain.
-                let (step, foot) = class.models().unwrap_or_else(|| {
-                    let (foot, step) = crate::scenario::default_models(&s.terrain);
-                    (step, foot)
-                });
-                assert_eq!((s.params.step_model, s.params.foot_model), (step, foot), "{}", s.name);
-                assert_eq!(class == Class::Stairs, step == StepModel::Stairs);
+                // Stairs name the models that climb treads shorter than the robot; the
+                // other classes name none, and the planner chooses from their heights.
+                match class.models() {
+                    Some((step, foot)) => {
+                        assert_eq!((s.params.step_model, s.params.foot_model), (step, foot));
+                        assert!(s.named_models.foot && s.named_models.step, "{}", s.name);
+                    }
+                    None => assert_eq!(s.named_models, Default::default(), "{}", s.name),
+                }
+                assert_eq!(class == Class::Stairs, s.params.step_model == StepModel::Stairs);
             }
         }
     }

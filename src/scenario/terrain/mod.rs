@@ -74,12 +74,6 @@ pub(crate) trait PrimitiveKind {
     /// The solids the primitive is made of, in world coordinates.
     fn solids(&self) -> Vec<Solid>;
 
-    /// The number of steps, if the primitive is a flight of stairs (for the models a
-    /// scenario that names none gets, `scenario::default_models`).
-    fn flight_steps(&self) -> Option<u32> {
-        None
-    }
-
     /// The same terrain written as boxes, where the kind is made of boxes alone and is
     /// not one: the same solids, so the same heights cell for cell and the same world
     /// (`momaro generate --stairs-as boxes`). `None` for the other kinds.
@@ -177,11 +171,6 @@ impl Primitive {
     /// step of a flight (the last one with the landing), a pole's cylinder.
     pub fn solids(&self) -> Vec<Solid> {
         self.unit().solids()
-    }
-
-    /// The number of steps of a flight of stairs; `None` for the other kinds.
-    pub fn flight_steps(&self) -> Option<u32> {
-        self.unit().flight_steps()
     }
 
     /// The primitive written as boxes where it is made of boxes but is not one (a flight

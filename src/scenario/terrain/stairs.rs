@@ -108,10 +108,6 @@ impl PrimitiveKind for Stairs {
             .collect()
     }
 
-    fn flight_steps(&self) -> Option<u32> {
-        Some(self.steps)
-    }
-
     /// A box per step from the ground to its tread, the last with the landing: the
     /// flight's own solids ([`Self::solids`]), written as `box` primitives (the yaw kept in
     /// degrees as given, so the boxes' solids are the flight's bit for bit).
@@ -163,7 +159,6 @@ mod tests {
         assert!((half_size[0] - 0.4).abs() < 1e-12);
         assert!((height - 0.45).abs() < 1e-12);
         assert!((s.max_height() - 0.45).abs() < 1e-12);
-        assert_eq!(s.flight_steps(), Some(3));
     }
 
     #[test]
@@ -177,7 +172,7 @@ mod tests {
             assert_eq!(boxes.len(), 3);
             let solids: Vec<Solid> = boxes.iter().flat_map(Primitive::solids).collect();
             assert_eq!(solids, flight.solids(), "yaw {yaw_deg}");
-            assert!(boxes.iter().all(|b| b.flight_steps().is_none() && b.kind() == "box"));
+            assert!(boxes.iter().all(|b| b.kind() == "box"));
         }
         // Other kinds are themselves.
         let pole = Primitive::Pole(crate::scenario::terrain::Pole {
