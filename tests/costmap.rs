@@ -47,6 +47,20 @@ fn costmap_writes_pngs_and_counts_cells() {
     // The unknown ring lies in the margin outside the scenario's map only.
     assert!(s.unknown_foot_cells > 0 && s.unknown_height_cells == 0, "{s:?}");
     assert!(rrd.metadata().map(|m| m.len() > 1000).unwrap_or(false));
+    // One riser (the platform's edge) is no flight: the paper's models.
+    assert_eq!(s.flight_risers, 1);
+    assert_eq!((s.foot_model.name(), s.step_model.name()), ("paper", "paper"));
+}
+
+#[test]
+fn costmap_reports_the_models_the_heights_call_for() {
+    // Six stacked boxes, no label, no models named: a flight of six risers, so the
+    // wheel pair's footprint and the stairs manoeuvres.
+    let opts =
+        CostmapOptions { sensed: false, png_dir: None, rerun: None, model_path: common::model() };
+    let s = run(&common::scenario("stairs_long_boxes"), &opts).unwrap();
+    assert_eq!(s.flight_risers, 6);
+    assert_eq!((s.foot_model.name(), s.step_model.name()), ("wheel_pair", "stairs"));
 }
 
 #[test]

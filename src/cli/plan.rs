@@ -68,6 +68,11 @@ pub fn plan(args: PlanArgs) -> anyhow::Result<bool> {
             print_json(&summary)?;
         } else {
             say!("scenario            {} ({})", summary.scenario, summary.algorithm);
+            say!(
+                "models              foot {}, step {}",
+                summary.foot_model.name(),
+                summary.step_model.name()
+            );
             for s in &summary.solutions {
                 say!(
                     "solution            ε {:.3}  cost {:.3}  {:.1} ms  {} expansions",

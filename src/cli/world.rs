@@ -88,6 +88,13 @@ pub fn costmap(args: CostmapArgs) -> anyhow::Result<bool> {
             s.cost_maps_time_s * 1e3
         );
         say!(
+            "models              foot {}, step {} (longest flight in the heights: {} riser{})",
+            s.foot_model.name(),
+            s.step_model.name(),
+            s.flight_risers,
+            if s.flight_risers == 1 { "" } else { "s" }
+        );
+        say!(
             "foot cost cells     {} infinite, {} unknown",
             s.infinite_foot_cells,
             s.unknown_foot_cells

@@ -100,6 +100,13 @@ pub struct CostmapSummary {
     pub height_map_time_s: f64,
     /// Time to build the cost layers (foot cost and body-cost maxima), s.
     pub cost_maps_time_s: f64,
+    /// The most risers of a flight of steps in the height map (`terrain::flights`).
+    pub flight_risers: u32,
+    /// The foot model of the layers: the file's, else the one the height map calls for
+    /// (`planner::terrain_models`).
+    pub foot_model: crate::params::FootModel,
+    /// The step model a plan on this map gets, chosen the same way.
+    pub step_model: crate::params::StepModel,
     /// Cells with infinite foot cost.
     pub infinite_foot_cells: usize,
     /// Cells with unknown foot cost.
@@ -164,6 +171,8 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
     let t = Instant::now();
     // The models the planner would choose on this map (the sensed one with --sensed).
     let params = crate::planner::scenario_params(scenario, &robot, &heights);
+    let flight_risers =
+        crate::terrain::longest_flight(&heights, &crate::planner::flight_rule(&robot, &params));
     let maps = CostMaps::build(&heights, &robot, &params)?;
     let cost_maps_time_s = t.elapsed().as_secs_f64();
 
@@ -207,6 +216,9 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
         origin: heights.origin(),
         height_map_time_s,
         cost_maps_time_s,
+        flight_risers,
+        foot_model: params.foot_model,
+        step_model: params.step_model,
         infinite_foot_cells: maps.infinite_foot_cells(),
         unknown_foot_cells: maps.unknown_foot_cells(),
         unknown_height_cells: maps.unknown_height_cells(),

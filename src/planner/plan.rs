@@ -527,7 +527,15 @@ mod tests {
         // model gets no hint; the paper's (asked for) is told which to set, and so is a
         // four-step flight; a three-step one (which the paper's model climbs) gets none.
         use crate::params::StepModel;
+        use crate::planner::graph::{Manoeuvre, ManoeuvreSet};
         use crate::planner::{ParamOverrides, prepare};
+        /// The hint needs the prepared world, not its manoeuvres.
+        struct NoManoeuvres;
+        impl ManoeuvreSet for NoManoeuvres {
+            fn instantiate(&self) -> Vec<Box<dyn Manoeuvre>> {
+                Vec::new()
+            }
+        }
         let robot = crate::robot::RobotDescription::reference();
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/stairs_long.toml");
@@ -535,7 +543,7 @@ mod tests {
         let hint = |text: &str, step_model| {
             let sc = crate::scenario::Scenario::parse(text, &path).unwrap();
             let overrides = ParamOverrides { step_model, ..ParamOverrides::default() };
-            let prep = prepare(&sc, &robot, overrides, &crate::motion::manoeuvres::ALL).unwrap();
+            let prep = prepare(&sc, &robot, overrides, &NoManoeuvres).unwrap();
             super::stairs_model_hint(&prep, &robot)
         };
         assert_eq!(hint(&text, None), "");

@@ -44,6 +44,9 @@ pub struct FlightRule {
 
 /// The most risers of any flight of `map` under `rule` (0 on terrain without risers).
 pub fn longest_flight(map: &HeightMap, rule: &FlightRule) -> u32 {
+    if !has_riser(map, rule) {
+        return 0;
+    }
     let res = map.resolution();
     let (nx, ny) = map.dims();
     let (w, h) = (nx as f64, ny as f64);
@@ -92,6 +95,32 @@ pub fn longest_flight(map: &HeightMap, rule: &FlightRule) -> u32 {
         }
     }
     best
+}
+
+/// Whether any two neighbouring cells (along x, y or a diagonal) differ by a riser:
+/// where none do (open floors, ramps, low clutter), no line needs scanning. Consecutive
+/// samples of a scan line lie in one cell or in neighbouring ones, so a line reads a
+/// riser only where this finds one.
+fn has_riser(map: &HeightMap, rule: &FlightRule) -> bool {
+    let (nx, ny) = map.dims();
+    let is_riser = |a: &f64, b: &f64| {
+        let d = (a - b).abs();
+        d >= rule.min_rise_m && d <= rule.max_rise_m
+    };
+    let row = |j: usize| &map.as_slice()[j * nx..(j + 1) * nx];
+    (0..ny).any(|j| {
+        let r = row(j);
+        if r.windows(2).any(|w| is_riser(&w[0], &w[1])) {
+            return true;
+        }
+        if j + 1 == ny {
+            return false;
+        }
+        let up = row(j + 1);
+        r.iter().zip(up).any(|(a, b)| is_riser(a, b))
+            || r.iter().zip(&up[1..]).any(|(a, b)| is_riser(a, b))
+            || r[1..].iter().zip(up).any(|(a, b)| is_riser(a, b))
+    })
 }
 
 /// The flight being read along one scan line.
