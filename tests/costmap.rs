@@ -60,6 +60,7 @@ fn costmap_reports_the_models_the_heights_call_for() {
         CostmapOptions { sensed: false, png_dir: None, rerun: None, model_path: common::model() };
     let s = run(&common::scenario("stairs_long_boxes"), &opts).unwrap();
     assert_eq!(s.flight_risers, 6);
+    assert!((s.flight_rise_m - 1.02).abs() < 1e-9, "{s:?}");
     assert_eq!((s.foot_model.name(), s.step_model.name()), ("wheel_pair", "stairs"));
 }
 

@@ -250,15 +250,16 @@ fn flights_longer_than_the_robot_need_the_stairs_step_model() {
 
 #[test]
 fn stairs_written_without_models_get_the_ones_that_climb_them_as_flights_or_boxes() {
-    // Building-code flights as a user writes them, naming no models: three steps (the
-    // paper's r_F disc leaves 5 cm of each 0.29 m tread, and the search had no path) and
-    // six (the paper's manoeuvres cannot climb a flight longer than the robot). The
+    // Building-code flights as a user writes them, naming no models: three steps, 0.51 m
+    // in all (the paper's r_F disc leaves 5 cm of each 0.29 m tread, and the search had no
+    // path; a flight taller than one step gets the stairs manoeuvres) and six (the
+    // paper's manoeuvres cannot climb a flight longer than the robot). The
     // planner reads the models off the heights, so the same flights written as a box per
     // step (the same heights cell for cell, no label) get the same plan, step for step,
     // at the same cost and expansions.
     let probe = probe_path();
     for (name, step_model, climbed) in
-        [("stairs_indoor", StepModel::Paper, 12), ("stairs_long", StepModel::Stairs, 24)]
+        [("stairs_indoor", StepModel::Stairs, 12), ("stairs_long", StepModel::Stairs, 24)]
     {
         let path = scenario_path(name);
         let text = std::fs::read_to_string(&path).expect("scenario");

@@ -415,8 +415,9 @@ pub struct PlannerArgs {
     pub foot_model: Option<FootModelArg>,
     /// Which manoeuvres prepare steps, for experiments (default: the scenario's `[params]
     /// step_model`, else chosen from the height map: `stairs`, every manoeuvre where the
-    /// terrain calls for it, where it has a flight of four or more steps, and `paper`, the
-    /// paper's manoeuvres alone, elsewhere; `planner::terrain_models`).
+    /// terrain calls for it, where it has a flight of four or more steps or one that climbs
+    /// more than 0.3 m, and `paper`, the paper's manoeuvres alone, elsewhere;
+    /// `planner::terrain_models`).
     #[arg(long, value_enum)]
     pub step_model: Option<StepModelArg>,
 }

@@ -88,11 +88,12 @@ pub fn costmap(args: CostmapArgs) -> anyhow::Result<bool> {
             s.cost_maps_time_s * 1e3
         );
         say!(
-            "models              foot {}, step {} (longest flight in the heights: {} riser{})",
+            "models              foot {}, step {} (flights in the heights: at most {} riser{}, {:.2} m)",
             s.foot_model.name(),
             s.step_model.name(),
             s.flight_risers,
-            if s.flight_risers == 1 { "" } else { "s" }
+            if s.flight_risers == 1 { "" } else { "s" },
+            s.flight_rise_m
         );
         say!(
             "foot cost cells     {} infinite, {} unknown",

@@ -102,6 +102,8 @@ pub struct CostmapSummary {
     pub cost_maps_time_s: f64,
     /// The most risers of a flight of steps in the height map (`terrain::flights`).
     pub flight_risers: u32,
+    /// The most height a flight of the map climbs, its risers summed, m.
+    pub flight_rise_m: f64,
     /// The foot model of the layers: the file's, else the one the height map calls for
     /// (`planner::terrain_models`).
     pub foot_model: crate::params::FootModel,
@@ -171,8 +173,7 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
     let t = Instant::now();
     // The models the planner would choose on this map (the sensed one with --sensed).
     let params = crate::planner::scenario_params(scenario, &robot, &heights);
-    let flight_risers =
-        crate::terrain::longest_flight(&heights, &crate::planner::flight_rule(&robot, &params));
+    let flights = crate::terrain::flights(&heights, &crate::planner::flight_rule(&robot, &params));
     let maps = CostMaps::build(&heights, &robot, &params)?;
     let cost_maps_time_s = t.elapsed().as_secs_f64();
 
@@ -216,7 +217,8 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
         origin: heights.origin(),
         height_map_time_s,
         cost_maps_time_s,
-        flight_risers,
+        flight_risers: flights.risers,
+        flight_rise_m: flights.rise_m,
         foot_model: params.foot_model,
         step_model: params.step_model,
         infinite_foot_cells: maps.infinite_foot_cells(),

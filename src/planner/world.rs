@@ -16,7 +16,7 @@ use crate::geometry::Pose2;
 use crate::params::{FootModel, Params, StepModel};
 use crate::robot::RobotDescription;
 use crate::scenario::Scenario;
-use crate::terrain::{FlightRule, HeightMap, longest_flight, rasterise};
+use crate::terrain::{FlightRule, HeightMap, flights, rasterise};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -182,9 +182,14 @@ pub(crate) fn endpoint(
 /// front feet never stand behind neutral, so the feet of one side stay a hip spacing
 /// (0.7 m) apart, and on a flight longer than the robot's 0.8 m feet span no footprint
 /// lets a rear foot step while the front feet stand on a tread (`docs/models.md`). Where
-/// the height map has such a flight, the stairs manoeuvres are chosen
-/// ([`terrain_models`]).
+/// the height map has such a flight (or one taller than a step), the stairs manoeuvres
+/// are chosen ([`terrain_models`]).
 pub const PAPER_MODEL_FLIGHT_STEPS: u32 = 4;
+
+/// How much a flight's summed risers may exceed the step limit and still count as within
+/// it, m: the float noise of adding rises (0.1 + 0.1 + 0.1 > 0.3), far below a height
+/// that matters to a foot.
+const RISE_TOLERANCE_M: f64 = 1e-6;
 
 /// What a flight is for `robot` under `params` (`terrain::flights`): a riser is a height
 /// change a wheel cannot drive over (ΔH_max, eq. 2) up to what a step overcomes (Sec. V);
@@ -212,19 +217,25 @@ pub fn flight_rule(robot: &RobotDescription, params: &Params) -> FlightRule {
 /// The planner's models for terrain `heights` (issue 63), chosen from heights and the
 /// robot alone: on a flight of steps ([`flight_rule`]) the wheel pair's contact footprint
 /// (the paper's r_F disc leaves 5 cm of foothold on a 0.29 m tread, less than the robot's
-/// 16 cm wheels stand on), and the stairs manoeuvres from [`PAPER_MODEL_FLIGHT_STEPS`]
-/// risers on; elsewhere the paper's models (beside walls the wheel pair needs 2 cm more
-/// than the disc, and doorways that the robot drove through it stepped through).
+/// 16 cm wheels stand on), and the stairs manoeuvres where the flight has
+/// [`PAPER_MODEL_FLIGHT_STEPS`] risers or more, or climbs more than one step of the paper
+/// may (`max_step_height_m`, 0.3 m: then the front and rear feet stand further apart in
+/// height than a step takes, and with the paper's manoeuvres three steep steps had no
+/// path); elsewhere the paper's models (beside walls the wheel pair needs 2 cm more than
+/// the disc, and doorways that the robot drove through it stepped through).
 pub fn terrain_models(
     heights: &HeightMap,
     robot: &RobotDescription,
     params: &Params,
 ) -> (FootModel, StepModel) {
-    match longest_flight(heights, &flight_rule(robot, params)) {
-        0 | 1 => (FootModel::Paper, StepModel::Paper),
-        n if n >= PAPER_MODEL_FLIGHT_STEPS => (FootModel::WheelPair, StepModel::Stairs),
-        _ => (FootModel::WheelPair, StepModel::Paper),
+    let f = flights(heights, &flight_rule(robot, params));
+    if f.risers < 2 {
+        return (FootModel::Paper, StepModel::Paper);
     }
+    // (A flight that climbs the step limit exactly is summed with float noise.)
+    let taller = f.rise_m > params.max_step_height_m + RISE_TOLERANCE_M;
+    let stairs = f.risers >= PAPER_MODEL_FLIGHT_STEPS || taller;
+    (FootModel::WheelPair, if stairs { StepModel::Stairs } else { StepModel::Paper })
 }
 
 /// The scenario's parameters on `heights`: the models its file does not name chosen
@@ -372,4 +383,40 @@ pub fn nearest_start(
         }
     }
     start
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::terrain::{Primitive, Stairs};
+
+    fn models_of(steps: u32, rise: f64, tread: f64) -> (FootModel, StepModel) {
+        let flight = Primitive::Stairs(Stairs {
+            start: [0.0, 0.0],
+            width: 1.2,
+            steps,
+            step_depth: tread,
+            step_height: rise,
+            landing_depth: 2.0,
+            yaw_deg: 25.0,
+        });
+        let heights = rasterise(&[flight], [-2.0, -3.0], [7.0, 6.0], 0.025).expect("map");
+        terrain_models(&heights, &RobotDescription::reference(), &Params::default())
+    }
+
+    #[test]
+    fn the_heights_choose_the_models() {
+        let (paper, wheels) = (FootModel::Paper, FootModel::WheelPair);
+        let (paper_steps, stairs) = (StepModel::Paper, StepModel::Stairs);
+        // One step is no flight; flat ground neither.
+        assert_eq!(models_of(1, 0.2, 0.3), (paper, paper_steps));
+        // Two low steps, 0.24 m in all: the wheel pair, the paper's steps.
+        assert_eq!(models_of(2, 0.12, 0.3), (wheels, paper_steps));
+        // Three steps of 0.1 m climb exactly the 0.3 m step limit: still the paper's.
+        assert_eq!(models_of(3, 0.1, 0.35), (wheels, paper_steps));
+        // Three steps of 0.17 m climb more than a step may: the stairs manoeuvres.
+        assert_eq!(models_of(3, 0.17, 0.29), (wheels, stairs));
+        // Four low steps: longer than the robot, the stairs manoeuvres.
+        assert_eq!(models_of(4, 0.06, 0.29), (wheels, stairs));
+    }
 }

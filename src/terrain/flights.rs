@@ -42,10 +42,24 @@ pub struct FlightRule {
     pub min_width_m: f64,
 }
 
+/// The longest and the tallest flight of a map.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Flights {
+    /// The most risers of any flight (0 on terrain without risers).
+    pub risers: u32,
+    /// The largest height that any flight climbs, its risers summed, m.
+    pub rise_m: f64,
+}
+
 /// The most risers of any flight of `map` under `rule` (0 on terrain without risers).
 pub fn longest_flight(map: &HeightMap, rule: &FlightRule) -> u32 {
+    flights(map, rule).risers
+}
+
+/// The longest and the tallest flight of `map` under `rule`.
+pub fn flights(map: &HeightMap, rule: &FlightRule) -> Flights {
     if !has_riser(map, rule) {
-        return 0;
+        return Flights::default();
     }
     let res = map.resolution();
     let (nx, ny) = map.dims();
@@ -54,7 +68,7 @@ pub fn longest_flight(map: &HeightMap, rule: &FlightRule) -> u32 {
     let max_tread = rule.max_tread_m / res;
     // Lanes side by side that a flight must cover.
     let lanes = ((rule.min_width_m / (res * LANE_CELLS as f64)).ceil() as usize).max(1);
-    let mut best = 0;
+    let mut best = Flights::default();
     for k in 0..SCAN_DIRECTIONS {
         let angle = std::f64::consts::PI * k as f64 / SCAN_DIRECTIONS as f64;
         let u = [angle.cos(), angle.sin()];
@@ -69,12 +83,12 @@ pub fn longest_flight(map: &HeightMap, rule: &FlightRule) -> u32 {
         };
         let (t0, t1) = span(u);
         let (o0, o1) = span(n);
-        // The longest flight each lane reads.
+        // The longest and the tallest flight each lane reads.
         let mut per_lane = Vec::new();
         let mut o = o0 + 0.5;
         while o < o1 {
             let mut line = Line::default();
-            let mut lane_best = 0;
+            let mut lane_best = Flights::default();
             let mut t = t0;
             while t <= t1 {
                 let x = o * n[0] + t * u[0];
@@ -83,15 +97,19 @@ pub fn longest_flight(map: &HeightMap, rule: &FlightRule) -> u32 {
                     .then(|| map.get(x as usize, y as usize))
                     .flatten();
                 line.sample(t, height, rule, min_tread, max_tread);
-                lane_best = lane_best.max(line.count);
+                lane_best.risers = lane_best.risers.max(line.count);
+                lane_best.rise_m = lane_best.rise_m.max(line.rise_m);
                 t += 1.0;
             }
             per_lane.push(lane_best);
             o += LANE_CELLS as f64;
         }
-        // The longest flight that `lanes` neighbouring lanes all read.
+        // The longest and the tallest flight that `lanes` neighbouring lanes all read.
         for window in per_lane.windows(lanes.min(per_lane.len())) {
-            best = best.max(window.iter().copied().min().unwrap_or(0));
+            let risers = window.iter().map(|f| f.risers).min().unwrap_or(0);
+            let rise = window.iter().map(|f| f.rise_m).fold(f64::INFINITY, f64::min);
+            best.risers = best.risers.max(risers);
+            best.rise_m = best.rise_m.max(rise);
         }
     }
     best
@@ -132,6 +150,8 @@ struct Line {
     last: Option<(f64, f64)>,
     /// Risers of the current flight.
     count: u32,
+    /// The height the current flight climbs (or descends), m.
+    rise_m: f64,
 }
 
 impl Line {
@@ -148,6 +168,7 @@ impl Line {
             self.previous = height;
             self.last = None;
             self.count = 0;
+            self.rise_m = 0.0;
             return;
         };
         self.previous = Some(h);
@@ -158,13 +179,20 @@ impl Line {
         if rise.abs() > rule.max_rise_m {
             self.last = None;
             self.count = 0;
+            self.rise_m = 0.0;
             return;
         }
         let sense = rise.signum();
         match self.last {
-            Some((s, at)) if s == sense && t - at < min_tread => {}
-            Some((s, at)) if s == sense && t - at <= max_tread => self.count += 1,
-            _ => self.count = 1,
+            Some((s, at)) if s == sense && t - at < min_tread => self.rise_m += rise.abs(),
+            Some((s, at)) if s == sense && t - at <= max_tread => {
+                self.count += 1;
+                self.rise_m += rise.abs();
+            }
+            _ => {
+                self.count = 1;
+                self.rise_m = rise.abs();
+            }
         }
         self.last = Some((sense, t));
     }
@@ -228,6 +256,45 @@ mod tests {
         };
         assert_eq!(count(&[narrow(0.9)]), 4);
         assert!(count(&[narrow(0.5)]) < 2);
+    }
+
+    #[test]
+    fn a_flight_climbs_its_risers_summed() {
+        let map =
+            |prims: &[Primitive]| rasterise(prims, [-3.0, -3.0], [8.0, 6.0], 0.025).expect("map");
+        let f = flights(&map(&[flight(3, 0.18, 0.3, 30.0)]), &RULE);
+        assert_eq!(f.risers, 3);
+        assert!((f.rise_m - 0.54).abs() < 1e-9, "{f:?}");
+        // A landing longer than the robot splits a flight: the taller part counts.
+        let lower = flight(3, 0.17, 0.29, 0.0);
+        let upper = Primitive::Stairs(Stairs {
+            start: [0.87 + 1.2, 0.0],
+            width: 1.2,
+            steps: 2,
+            step_depth: 0.29,
+            step_height: 0.17,
+            landing_depth: 0.0,
+            yaw_deg: 0.0,
+        });
+        let mut prims = lower.as_boxes();
+        // The landing: 1.2 m at the top of the lower flight.
+        prims.push(Primitive::Box(Block {
+            center: [0.87 + 0.6, 0.0],
+            size: [1.2, 1.2],
+            height: 0.51,
+            yaw_deg: 0.0,
+        }));
+        // The upper flight stands on the landing: its boxes raised by it.
+        for b in upper.as_boxes() {
+            if let Primitive::Box(b) = b {
+                prims.push(Primitive::Box(Block { height: b.height + 0.51, ..b }));
+            }
+        }
+        let f = flights(&map(&prims), &RULE);
+        assert_eq!(f.risers, 3, "{f:?}");
+        assert!((f.rise_m - 0.51).abs() < 1e-9, "{f:?}");
+        // No risers: nothing climbed.
+        assert_eq!(flights(&map(&[]), &RULE), Flights::default());
     }
 
     #[test]
