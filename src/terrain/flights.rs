@@ -1,8 +1,9 @@
 //! Flights of steps read from a height map alone: how many risers follow each other,
 //! all up or all down, with treads between them too short for the whole robot to stand
-//! on one (the feet then stand on different levels, as on stairs).
+//! on one (the feet then stand on different levels, as on stairs), and how high they
+//! climb in all.
 //!
-//! The planner chooses the models a scenario does not name from this count
+//! The planner chooses the models a scenario does not name from these flights
 //! (`planner::world::terrain_models`), so a flight written as a `stairs` primitive, as
 //! stacked boxes, or seen by the laser is the same terrain to it: only heights count.
 //!
