@@ -172,8 +172,8 @@ pub fn run(scenario: &Scenario, opts: &CostmapOptions) -> Result<CostmapSummary,
     let robot = Simulation::robot_only(&opts.model_path)?.robot().clone();
     let t = Instant::now();
     // The models the planner would choose on this map (the sensed one with --sensed).
-    let params = crate::planner::scenario_params(scenario, &robot, &heights);
-    let flights = crate::terrain::flights(&heights, &crate::planner::flight_rule(&robot, &params));
+    let flights = crate::planner::terrain_flights(&heights, &robot, &scenario.params);
+    let params = crate::planner::scenario_params(scenario, &flights);
     let maps = CostMaps::build(&heights, &robot, &params)?;
     let cost_maps_time_s = t.elapsed().as_secs_f64();
 

@@ -50,5 +50,5 @@ pub use orientation::OrientationFactor;
 pub use plan::{PlanSummary, run, run_on};
 pub use world::{
     PAPER_MODEL_FLIGHT_STEPS, Prepared, flight_rule, nearest_start, params_for, prepare,
-    prepare_for, scenario_heights, scenario_params, terrain_models,
+    prepare_for, scenario_heights, scenario_params, terrain_flights, terrain_models,
 };

@@ -17,9 +17,7 @@
 
 use super::graph::ManoeuvreSet;
 use super::options::{ParamOverrides, PlanError, PlanOptions, bad, check_options};
-use super::world::{
-    MapInfo, PAPER_MODEL_FLIGHT_STEPS, Prepared, flight_rule, params_for, prepare_for,
-};
+use super::world::{MapInfo, PAPER_MODEL_FLIGHT_STEPS, Prepared, params_for, prepare_for};
 use super::{HybridGraph, LatticeState, ManoeuvreStats, Neighbourhood, PoseKey};
 use crate::params::{FootModel, StepModel};
 use crate::path::{ManoeuvreKind, PathElement};
@@ -31,7 +29,6 @@ use crate::search::{
     arastar_with_hooks, astar_with_hooks,
 };
 use crate::terrain::HeightMap;
-use crate::terrain::longest_flight;
 use serde::Serialize;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
@@ -271,7 +268,7 @@ pub fn run_on_counted(
     counts: Option<&mut Option<ExpansionCounts>>,
 ) -> Result<PlanSummary, PlanError> {
     let limit = check_options(opts)?;
-    let params = params_for(scenario, robot, prep.maps.heights(), opts.overrides)?;
+    let params = params_for(scenario, &prep.flights, opts.overrides)?;
     if params != prep.params {
         return Err(bad(
             "prepared",
@@ -284,8 +281,8 @@ pub fn run_on_counted(
 /// What a "no path" adds for a plan with the paper's step model (named in the file or
 /// asked for) on a height map with a flight of [`PAPER_MODEL_FLIGHT_STEPS`] risers or
 /// more: the models that climb it. Empty otherwise.
-fn stairs_model_hint(prep: &Prepared, robot: &RobotDescription) -> String {
-    let n = longest_flight(prep.maps.heights(), &flight_rule(robot, &prep.params));
+fn stairs_model_hint(prep: &Prepared) -> String {
+    let n = prep.flights.risers;
     if prep.params.step_model == StepModel::Paper && n >= PAPER_MODEL_FLIGHT_STEPS {
         format!(
             "; its height map has a flight of {n} steps, and with step_model = \"paper\" \
@@ -364,7 +361,7 @@ fn search_prepared(
             ),
             t => format!("the search stopped ({})", termination_name(t)),
         };
-        let reason = reason + &stairs_model_hint(prep, robot);
+        let reason = reason + &stairs_model_hint(prep);
         return Err(PlanError::NoPath {
             scenario: file(),
             termination: result.termination,
@@ -544,7 +541,7 @@ mod tests {
             let sc = crate::scenario::Scenario::parse(text, &path).unwrap();
             let overrides = ParamOverrides { step_model, ..ParamOverrides::default() };
             let prep = prepare(&sc, &robot, overrides, &NoManoeuvres).unwrap();
-            super::stairs_model_hint(&prep, &robot)
+            super::stairs_model_hint(&prep)
         };
         assert_eq!(hint(&text, None), "");
         let said = hint(&text, Some(StepModel::Paper));

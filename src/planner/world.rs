@@ -16,7 +16,7 @@ use crate::geometry::Pose2;
 use crate::params::{FootModel, Params, StepModel};
 use crate::robot::RobotDescription;
 use crate::scenario::Scenario;
-use crate::terrain::{FlightRule, HeightMap, flights, rasterise};
+use crate::terrain::{FlightRule, Flights, HeightMap, flights, rasterise};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -40,6 +40,9 @@ pub struct MapInfo {
 pub struct Prepared {
     /// The parameters with the options' overrides.
     pub params: Params,
+    /// The flights of steps the height map shows ([`terrain_flights`]), which chose the
+    /// models the scenario does not name.
+    pub flights: Flights,
     /// The cost client.
     pub maps: CostMaps,
     /// The lattice over the maps.
@@ -123,7 +126,8 @@ pub fn prepare(
 ) -> Result<Prepared, PlanError> {
     let t0 = Instant::now();
     let heights = scenario_heights(scenario)?;
-    let params = params_for(scenario, robot, &heights, overrides)?;
+    let flights = terrain_flights(&heights, robot, &scenario.params);
+    let params = params_for(scenario, &flights, overrides)?;
     let (maps, lattice) = build_maps(scenario, robot, &params, &heights)?;
     let endpoint = |which, pose| endpoint(scenario, robot, &params, (&maps, &lattice), which, pose);
     let start = endpoint("start", scenario.start)?;
@@ -132,6 +136,7 @@ pub fn prepare(
         start,
         goal,
         params,
+        flights,
         maps,
         lattice,
         setup_time_s: t0.elapsed().as_secs_f64(),
@@ -214,21 +219,23 @@ pub fn flight_rule(robot: &RobotDescription, params: &Params) -> FlightRule {
     }
 }
 
-/// The planner's models for terrain `heights` (issue 63), chosen from heights and the
-/// robot alone: on a flight of steps ([`flight_rule`]) the wheel pair's contact footprint
-/// (the paper's r_F disc leaves 5 cm of foothold on a 0.29 m tread, less than the robot's
-/// 16 cm wheels stand on), and the stairs manoeuvres where the flight has
-/// [`PAPER_MODEL_FLIGHT_STEPS`] risers or more, or climbs more than one step of the paper
-/// may (`max_step_height_m`, 0.3 m: then the front and rear feet stand further apart in
-/// height than a step takes, and with the paper's manoeuvres three steep steps had no
-/// path); elsewhere the paper's models (beside walls the wheel pair needs 2 cm more than
-/// the disc, and doorways that the robot drove through it stepped through).
-pub fn terrain_models(
-    heights: &HeightMap,
-    robot: &RobotDescription,
-    params: &Params,
-) -> (FootModel, StepModel) {
-    let f = flights(heights, &flight_rule(robot, params));
+/// The flights of steps of `heights` for `robot` under `params` ([`flight_rule`]): what
+/// [`terrain_models`] chooses from.
+pub fn terrain_flights(heights: &HeightMap, robot: &RobotDescription, params: &Params) -> Flights {
+    flights(heights, &flight_rule(robot, params))
+}
+
+/// The planner's models for a terrain whose flights of steps are `f`
+/// ([`terrain_flights`], issue 63), chosen from heights and the robot alone: on a flight
+/// the wheel pair's contact footprint (the paper's r_F disc leaves 5 cm of foothold on a
+/// 0.29 m tread, less than the robot's 16 cm wheels stand on), and the stairs manoeuvres
+/// where the flight has [`PAPER_MODEL_FLIGHT_STEPS`] risers or more, or climbs more than
+/// one step of the paper may (`max_step_height_m`, 0.3 m: then the front and rear feet
+/// stand further apart in height than a step takes, and with the paper's manoeuvres three
+/// steep steps had no path); elsewhere the paper's models (beside walls the wheel pair
+/// needs 2 cm more than the disc, and doorways that the robot drove through it stepped
+/// through).
+pub fn terrain_models(f: &Flights, params: &Params) -> (FootModel, StepModel) {
     if f.risers < 2 {
         return (FootModel::Paper, StepModel::Paper);
     }
@@ -238,23 +245,17 @@ pub fn terrain_models(
     (FootModel::WheelPair, if stairs { StepModel::Stairs } else { StepModel::Paper })
 }
 
-/// The scenario's parameters on `heights`: the models its file does not name chosen
-/// from the terrain ([`terrain_models`]).
-pub fn scenario_params(
-    scenario: &Scenario,
-    robot: &RobotDescription,
-    heights: &HeightMap,
-) -> Params {
+/// The scenario's parameters on a terrain whose flights are `flights`: the models its
+/// file does not name chosen from them ([`terrain_models`]).
+pub fn scenario_params(scenario: &Scenario, flights: &Flights) -> Params {
     let mut params = scenario.params.clone();
     let named = scenario.named_models;
-    if !(named.foot && named.step) {
-        let (foot, step) = terrain_models(heights, robot, &params);
-        if !named.foot {
-            params.foot_model = foot;
-        }
-        if !named.step {
-            params.step_model = step;
-        }
+    let (foot, step) = terrain_models(flights, &params);
+    if !named.foot {
+        params.foot_model = foot;
+    }
+    if !named.step {
+        params.step_model = step;
     }
     params
 }
@@ -265,11 +266,10 @@ pub fn scenario_params(
 /// [`PlanError::Params`] naming the scenario.
 pub fn params_for(
     scenario: &Scenario,
-    robot: &RobotDescription,
-    heights: &HeightMap,
+    flights: &Flights,
     overrides: ParamOverrides,
 ) -> Result<Params, PlanError> {
-    let params = overrides.apply(scenario_params(scenario, robot, heights));
+    let params = overrides.apply(scenario_params(scenario, flights));
     params
         .validate()
         .map_err(|source| PlanError::Params { scenario: scenario.path.clone(), source })?;
@@ -401,7 +401,9 @@ mod tests {
             yaw_deg: 25.0,
         });
         let heights = rasterise(&[flight], [-2.0, -3.0], [7.0, 6.0], 0.025).expect("map");
-        terrain_models(&heights, &RobotDescription::reference(), &Params::default())
+        let params = Params::default();
+        let flights = terrain_flights(&heights, &RobotDescription::reference(), &params);
+        terrain_models(&flights, &params)
     }
 
     #[test]

@@ -52,11 +52,6 @@ pub struct Flights {
     pub rise_m: f64,
 }
 
-/// The most risers of any flight of `map` under `rule` (0 on terrain without risers).
-pub fn longest_flight(map: &HeightMap, rule: &FlightRule) -> u32 {
-    flights(map, rule).risers
-}
-
 /// The longest and the tallest flight of `map` under `rule`.
 pub fn flights(map: &HeightMap, rule: &FlightRule) -> Flights {
     if !has_riser(map, rule) {
@@ -230,7 +225,7 @@ mod tests {
 
     fn count(prims: &[Primitive]) -> u32 {
         let map = rasterise(prims, [-3.0, -3.0], [8.0, 6.0], 0.025).expect("map");
-        longest_flight(&map, &RULE)
+        flights(&map, &RULE).risers
     }
 
     #[test]
@@ -335,7 +330,7 @@ mod tests {
     fn unknown_cells_end_a_flight() {
         let mut map =
             rasterise(&[flight(4, 0.18, 0.3, 0.0)], [-1.0, -1.0], [3.0, 2.0], 0.025).expect("map");
-        assert_eq!(longest_flight(&map, &RULE), 4);
+        assert_eq!(flights(&map, &RULE).risers, 4);
         // Unknown across the second tread (x in 0.33..0.57 m): flights of 2 and 2 remain.
         let (nx, ny) = map.dims();
         for j in 0..ny {
@@ -346,6 +341,6 @@ mod tests {
                 }
             }
         }
-        assert_eq!(longest_flight(&map, &RULE), 2);
+        assert_eq!(flights(&map, &RULE).risers, 2);
     }
 }

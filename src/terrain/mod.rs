@@ -12,7 +12,7 @@ pub mod rasterise;
 pub mod scenario_map;
 pub mod sensed;
 
-pub use flights::{FlightRule, Flights, flights, longest_flight};
+pub use flights::{FlightRule, Flights, flights};
 pub use heightmap::{HeightMap, HeightMapError, HeightMapView, square_window_max};
 pub use rasterise::{RasteriseError, rasterise, rasterise_into};
 pub use scenario_map::{map_grid, scenario_map};
