@@ -218,6 +218,9 @@ fn bench_scaling_plans_one_course_on_growing_maps_and_growing_courses_on_one_map
             .map(|k| r[*k].as_f64().unwrap())
             .sum();
         assert!(part > 0.0 && part <= r["time_s"].as_f64().unwrap(), "{r}");
+        // A warm replan from the path's middle, on the tables the cold plan left.
+        assert!(r["warm_replan_s"].as_f64().is_some_and(|t| t > 0.0), "{r}");
+        assert!(r["warm_replan_expansions"].as_u64().is_some(), "{r}");
     }
     // The same course on both maps: the same plan.
     assert_eq!(rows[0]["cost"], rows[1]["cost"]);

@@ -211,9 +211,14 @@ pub fn bench_scaling(args: BenchScalingArgs) -> anyhow::Result<bool> {
     if json {
         print_json(&b)?;
     } else {
-        say!("{} (cold first path, medians of {} runs; ms)", b.scenario, b.repeats);
         say!(
-            "{:<7} {:>6} {:>10} {:>8} {:>10} {:>9} {:>9} {:>9} {:>10} {:>11} {:>10}",
+            "{} (cold first path, medians of {} runs; ms; warm: a replan from the path's \
+             middle to the same goal)",
+            b.scenario,
+            b.repeats
+        );
+        say!(
+            "{:<7} {:>6} {:>10} {:>8} {:>10} {:>9} {:>9} {:>9} {:>10} {:>11} {:>10} {:>9}",
             "sweep",
             "map m",
             "cells",
@@ -224,11 +229,12 @@ pub fn bench_scaling(args: BenchScalingArgs) -> anyhow::Result<bool> {
             "search",
             "c-t-g nodes",
             "expansions",
-            "cost"
+            "cost",
+            "warm"
         );
         for r in &b.rows {
             say!(
-                "{:<7} {:>6.1} {:>10} {:>8.2} {:>10.1} {:>9.1} {:>9.1} {:>9.1} {:>10} {:>11} {:>10}",
+                "{:<7} {:>6.1} {:>10} {:>8.2} {:>10.1} {:>9.1} {:>9.1} {:>9.1} {:>10} {:>11} {:>10} {:>9}",
                 r.sweep,
                 r.map_m,
                 r.cells,
@@ -239,7 +245,8 @@ pub fn bench_scaling(args: BenchScalingArgs) -> anyhow::Result<bool> {
                 r.search_s * 1e3,
                 r.cost_to_go_nodes,
                 r.expansions,
-                r.cost.map_or_else(|| r.outcome.to_owned(), |c| format!("{c:.3}"))
+                r.cost.map_or_else(|| r.outcome.to_owned(), |c| format!("{c:.3}")),
+                r.warm_replan_s.map_or_else(|| "-".to_owned(), |t| format!("{:.1}", t * 1e3))
             );
         }
         let ratio = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));

@@ -12,12 +12,16 @@
 //!
 //! Each row reports the medians over the repeats of the whole wall time and of its parts
 //! (maps, heuristic set-up, search), and what the plan did (its cost-to-go's settled
-//! nodes, expansions, cost). Times are measurements on a noisy machine, never asserted.
+//! nodes, expansions, cost). Then, on the same world, a *warm replan*: the first path
+//! again from the path's middle pose to the same goal, with the heuristic tables the cold
+//! plan left (`HeuristicCache`), as the closed loop replans from where the robot stands.
+//! Times are measurements on a noisy machine, never asserted.
 
 use super::bench::{failed_outcome, first_path_options, median};
 use crate::geometry::Pose2;
+use crate::motion::manoeuvres::ALL;
 use crate::planner::options::bad;
-use crate::planner::{self, PlanError};
+use crate::planner::{self, PlanError, PlanOptions, PlanSummary, Prepared};
 use crate::robot::RobotDescription;
 use crate::scenario::{MapExtent, Scenario};
 use serde::Serialize;
@@ -81,6 +85,11 @@ pub struct ScalingRow {
     pub expansions: u64,
     /// The path's cost, when one was found.
     pub cost: Option<f64>,
+    /// Median search time of the warm replan from the path's middle pose, s (`None`
+    /// without a path, or where that pose cannot start a plan).
+    pub warm_replan_s: Option<f64>,
+    /// Expansions of the warm replan (last repeat).
+    pub warm_replan_expansions: Option<u64>,
 }
 
 /// Result of `bench scaling`.
@@ -196,17 +205,24 @@ pub fn scaling_bench(
     let mut rows = Vec::with_capacity(total);
     for (sweep, side, sc) in courses {
         let mut times = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
-        let mut last = None;
+        let mut warm_times = Vec::new();
+        let (mut last, mut last_warm) = (None, None);
         let mut outcome = "path";
         for _ in 0..opts.repeats {
             let t = Instant::now();
-            let result = planner::run(&sc, robot, &plan_opts, &crate::motion::manoeuvres::ALL);
+            let prepared = planner::prepare_for(&sc, robot, &plan_opts, &ALL);
+            let result = prepared
+                .and_then(|prep| Ok((planner::run_on(&prep, &sc, robot, &plan_opts)?, prep)));
             let wall = t.elapsed().as_secs_f64();
             match result {
-                Ok(s) => {
+                Ok((s, mut prep)) => {
                     let parts = [wall, s.setup_time_s, s.heuristic.setup_time_s, s.planning_time_s];
                     for (v, p) in times.iter_mut().zip(parts) {
                         v.push(p);
+                    }
+                    last_warm = warm_replan(&mut prep, &sc, robot, &plan_opts, &s);
+                    if let Some(w) = &last_warm {
+                        warm_times.push(w.planning_time_s);
                     }
                     outcome = "path";
                     last = Some(s);
@@ -233,6 +249,8 @@ pub fn scaling_bench(
             cost_to_go_nodes: last.as_ref().map_or(0, |s| s.heuristic.cost_to_go_nodes),
             expansions: last.as_ref().map_or(0, |s| s.expansions),
             cost: last.as_ref().map(|s| s.cost),
+            warm_replan_s: (!warm_times.is_empty()).then(|| median(warm_times)),
+            warm_replan_expansions: last_warm.as_ref().map(|w| w.expansions),
         });
         if let Some(r) = rows.last() {
             on_row(rows.len(), total, r);
@@ -252,6 +270,21 @@ pub fn scaling_bench(
         length_ratio: ratio("length"),
         rows,
     })
+}
+
+/// The warm replan of a row: `prep`'s start moved to the middle pose of `cold`'s path
+/// and the first path planned again, on the tables `cold` left. `None` where that pose
+/// cannot start a plan or the replan fails (the row then reports no replan).
+fn warm_replan(
+    prep: &mut Prepared,
+    sc: &Scenario,
+    robot: &RobotDescription,
+    opts: &PlanOptions,
+    cold: &PlanSummary,
+) -> Option<PlanSummary> {
+    let middle = cold.path.get(cold.path.len() / 2)?.pose;
+    prep.set_start(sc, robot, middle).ok()?;
+    planner::run_on(prep, sc, robot, opts).ok()
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! The hybrid graph's heuristic (issues 4 and 15) and the guidance of ARA*'s probe.
 //!
-//! - [`cost_to_go`]: the driving part — a lazy backward Dijkstra over base cells whose
+//! - [`cost_to_go`]: the driving part — a lazy backward search over base cells (an A*
+//!   aimed at the first query, the start: Dijkstra's distances, fewer nodes) whose
 //!   edges relax drives (the smallest pose cost over orientations, eq. 4), turns and base
 //!   shifts; consistent on every manoeuvre.
 //! - [`step_bound`]: the informed part — a lower bound on the step costs (eq. 5) each foot
@@ -22,9 +23,10 @@
 //!    drives and base shifts cost at least the distance they move the base (pose costs
 //!    ≥ 1, k_Δθ ≥ 1, and a base shift's cost is at least its move); turns cost at least
 //!    their arc;
-//! 2. `D` is the cost-to-go of the `cost_to_go` module: a lazy backward Dijkstra over
-//!    (cell, orientation) whose edges relax drives (the pose cost of eq. 4 at that
-//!    orientation, k_Δθ), turns and base shifts (f · k10 per cell, plus Φ's rise);
+//! 2. `D` is the cost-to-go of the `cost_to_go` module: a lazy backward search (A*,
+//!    exact distances) over (cell, orientation) whose edges relax drives (the pose cost
+//!    of eq. 4 at that orientation, k_Δθ), turns and base shifts (f · k10 per cell,
+//!    plus Φ's rise);
 //!    consistent on every manoeuvre, with Φ on base shifts. The larger of two consistent
 //!    heuristics is consistent, and both parts leave the same share of each edge's cost
 //!    to the parts below (none of drives and turns, Φ's rise on base shifts, all of

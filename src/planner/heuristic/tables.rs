@@ -43,8 +43,8 @@ pub struct HeuristicTables {
     pub regions: BaseRegions,
     /// The step-cost part (`step_bound`); zero everywhere without steps.
     pub step_bound: StepBound,
-    /// The driving and base-shift part (`cost_to_go`): a backward Dijkstra over base
-    /// cells, run lazily as far as the queries need.
+    /// The driving and base-shift part (`cost_to_go`): a backward search over base
+    /// cells (an A* aimed at the start), run lazily as far as the queries need.
     pub cost_to_go: CostToGo,
     /// The feet's way to the goal over terrain they could climb (`way`): the greedy
     /// list's distance where it exceeds the straight line.
