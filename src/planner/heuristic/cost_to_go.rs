@@ -926,6 +926,12 @@ mod tests {
 
     const GOAL: (i16, i16, Option<u8>) = (100, 32, Some(0));
 
+    /// The cost-to-go of [`setup`]'s world toward [`GOAL`] with `groups` orientation
+    /// groups and a base-shift link of 0.3.
+    fn grouped(lattice: Lattice, driving: &DrivingConfig, groups: usize) -> CostToGo {
+        CostToGo::new(lattice, driving, Cost::from_f64_floor(0.3), GOAL, (groups, usize::MAX))
+    }
+
     #[test]
     fn a_node_record_keeps_its_three_fields_apart() {
         let mut r = 0u64;
@@ -1100,13 +1106,7 @@ mod tests {
         // H(c) <= w + H(n), for aims on the map's corners, the box and the goal.
         let (maps, lattice, driving) = setup();
         for groups in [64, 8, 1] {
-            let ctg = CostToGo::new(
-                lattice,
-                &driving,
-                Cost::from_f64_floor(0.3),
-                GOAL,
-                (groups, usize::MAX),
-            );
+            let ctg = grouped(lattice, &driving, groups);
             let mut poses = pose_cache(&ctg, &maps);
             let (nx, ny) = (i32::from(lattice.nx), i32::from(lattice.ny));
             let cells = ctg.cells();
@@ -1195,13 +1195,7 @@ mod tests {
         // scattered order (each query resumes the lazy search where the last stopped).
         let (maps, lattice, driving) = setup();
         for groups in [64, 8, 1] {
-            let ctg = CostToGo::new(
-                lattice,
-                &driving,
-                Cost::from_f64_floor(0.3),
-                GOAL,
-                (groups, usize::MAX),
-            );
+            let ctg = grouped(lattice, &driving, groups);
             let (gi, gj, _) = GOAL;
             let root = layer_of(0, ctg.group, ctg.layers) * ctg.cells()
                 + gj as usize * usize::from(lattice.nx)
