@@ -162,9 +162,7 @@ impl Line {
         let (Some(h), Some(p)) = (height, self.previous) else {
             // An unknown sample (or the line's first): no flight continues across it.
             self.previous = height;
-            self.last = None;
-            self.count = 0;
-            self.rise_m = 0.0;
+            self.end_flight();
             return;
         };
         self.previous = Some(h);
@@ -173,9 +171,7 @@ impl Line {
             return;
         }
         if rise.abs() > rule.max_rise_m {
-            self.last = None;
-            self.count = 0;
-            self.rise_m = 0.0;
+            self.end_flight();
             return;
         }
         let sense = rise.signum();
@@ -191,6 +187,13 @@ impl Line {
             }
         }
         self.last = Some((sense, t));
+    }
+
+    /// No flight goes on past here: the next riser starts a new one.
+    fn end_flight(&mut self) {
+        self.last = None;
+        self.count = 0;
+        self.rise_m = 0.0;
     }
 }
 

@@ -181,12 +181,11 @@ struct Search {
     queue: Buckets,
     /// Nodes settled so far (expanded at their current distance).
     settled: usize,
-    /// The node the search is aimed at, `(i, j, layer)`: the first query's.
-    aim: (i32, i32, usize),
+    /// The node the search is aimed at, `(i, j, layer)`: the first query's (`None`
+    /// before it, when nothing is queued yet).
+    aim: Option<(i32, i32, usize)>,
     /// The goal's nodes, queued when the first query sets the aim.
     roots: Vec<usize>,
-    /// Whether the roots are queued.
-    started: bool,
     /// Set when the deadline passed: a lower bound on `D` of every unsettled node.
     frozen: Option<Cost>,
     /// Distances from this on are not kept ([`MAX_DIST`]; lower in tests).
@@ -293,10 +292,11 @@ impl CostToGo {
         let node = layer * self.cells() + cell;
         let at = (i32::from(i), i32::from(j), layer);
         let mut search = self.search.borrow_mut();
-        if !search.started {
-            self.start(&mut search, at);
-        }
-        let h = self.aim_bound(search.aim, at);
+        let aim = match search.aim {
+            Some(aim) => aim,
+            None => self.start(&mut search, at),
+        };
+        let h = self.aim_bound(aim, at);
         loop {
             if search.is_final(node, h) {
                 return search.nodes[node].dist();
@@ -321,16 +321,21 @@ impl CostToGo {
         }
     }
 
-    /// Aims the search at node `aim` (the first query's) and queues the goal's nodes.
-    fn start(&self, search: &mut Search, aim: (i32, i32, usize)) {
-        search.aim = aim;
-        search.started = true;
-        let (nx, cells) = (usize::from(self.lattice.nx), self.cells());
+    /// Aims the search at node `aim` (the first query's) and queues the goal's nodes;
+    /// returns the aim.
+    fn start(&self, search: &mut Search, aim: (i32, i32, usize)) -> (i32, i32, usize) {
+        search.aim = Some(aim);
         for r in std::mem::take(&mut search.roots) {
-            let (t, cell) = (r / cells, r % cells);
-            let at = ((cell % nx) as i32, (cell / nx) as i32, t);
-            search.queue.push(self.aim_bound(aim, at), r as u32);
+            search.queue.push(self.aim_bound(aim, self.coords(r)), r as u32);
         }
+        aim
+    }
+
+    /// Cell (i, j) and layer of node `node`.
+    fn coords(&self, node: usize) -> (i32, i32, usize) {
+        let (nx, cells) = (usize::from(self.lattice.nx), self.cells());
+        let cell = node % cells;
+        ((cell % nx) as i32, (cell / nx) as i32, node / cells)
     }
 
     /// `H`, the aim bound: a lower bound on the relaxed graph's distance between node
@@ -409,13 +414,11 @@ impl CostToGo {
     /// [`Self::pose_bound`] of a node not yet computed.
     #[inline(never)]
     fn compute_pose_bound(&self, search: &mut Search, maps: &CostMaps, node: usize) -> f64 {
-        let nx = usize::from(self.lattice.nx);
-        let cells = self.cells();
-        let cell = node % cells;
-        let (i, j) = (cell % nx, cell / nx);
+        let (i, j, layer) = self.coords(node);
+        let (i, j) = (i as usize, j as usize);
         let orientations = usize::from(self.lattice.orientations).max(1);
         let mut best = f64::INFINITY;
-        for theta in members(node / cells, self.group, orientations) {
+        for theta in members(layer, self.group, orientations) {
             let cost = match &search.stencils[theta] {
                 Some(stencil) => maps.driving_pose_cost_at(i, j, stencil),
                 None => {
@@ -455,6 +458,7 @@ impl CostToGo {
                 .map(|k| maps.driving_stencil(self.lattice.yaw(k as u8)))
                 .collect();
         }
+        let Some(aim) = search.aim else { return };
         let (nx, ny) = (i32::from(self.lattice.nx), i32::from(self.lattice.ny));
         let (layers, cells) = (self.layers, self.cells());
         for _ in 0..budget {
@@ -479,13 +483,13 @@ impl CostToGo {
             let (ci, cj) = ((cell % nx as usize) as i32, (cell / nx as usize) as i32);
             let node_at = |a: i32, b: i32| layer + (b * nx + a) as usize;
             // The aim bound's turn part of c's layer, which drives and shifts keep.
-            let turns = self.aim_turns(search.aim.2, t);
+            let turns = self.aim_turns(aim.2, t);
             // Base shifts into c: from c minus a link of its layer.
             for &(di, dj) in &self.shift_links[t] {
                 let (a, b) = (ci - di, cj - dj);
                 if a >= 0 && b >= 0 && a < nx && b < ny {
                     let w = d.saturating_add(self.shift_step);
-                    self.relax(search, node_at(a, b), w, (a, b), turns);
+                    self.relax(search, aim, node_at(a, b), w, (a, b), turns);
                 }
             }
             let pc = self.pose_bound(search, maps, c);
@@ -511,7 +515,7 @@ impl CostToGo {
                 let pa = self.pose_bound(search, maps, n);
                 if pa.is_finite() {
                     let w = relaxed_weight(length, pa, pc);
-                    self.relax(search, n, d.saturating_add(w), (a, b), turns);
+                    self.relax(search, aim, n, d.saturating_add(w), (a, b), turns);
                 }
             }
             // Turns on the spot into c: from the neighbouring orientations.
@@ -521,8 +525,8 @@ impl CostToGo {
                     let pa = self.pose_bound(search, maps, n);
                     if pa.is_finite() {
                         let w = relaxed_weight(self.turn_length, pa, pc);
-                        let turns = self.aim_turns(search.aim.2, t2);
-                        self.relax(search, n, d.saturating_add(w), (ci, cj), turns);
+                        let turns = self.aim_turns(aim.2, t2);
+                        self.relax(search, aim, n, d.saturating_add(w), (ci, cj), turns);
                     }
                 }
             }
@@ -530,14 +534,22 @@ impl CostToGo {
     }
 
     /// Lowers node `n`'s (at cell (a, b), `turns` the aim bound's turn part of its
-    /// layer) tentative distance to `d` and queues it under its key `d + H`, if `d` is
+    /// layer, toward `aim`) tentative distance to `d` and queues it under its key `d + H`, if `d` is
     /// lower. A node expanded within the bucket being taken may be
     /// lowered so (the keys of a bucket are taken in any order) and is reopened; one
     /// final never is. A `d` from [`MAX_DIST`] on is not kept but marks the search
     /// capped: once its queue runs empty, every node it did not settle lies at least
     /// `MAX_DIST` away (or has no path), and gets that bound (see [`Self::get`]).
     #[inline(always)]
-    fn relax(&self, search: &mut Search, n: usize, d: Cost, (a, b): (i32, i32), turns: u64) {
+    fn relax(
+        &self,
+        search: &mut Search,
+        aim: (i32, i32, usize),
+        n: usize,
+        d: Cost,
+        (a, b): (i32, i32),
+        turns: u64,
+    ) {
         let record = &mut search.nodes[n];
         if d < record.dist() {
             if d >= search.cap {
@@ -549,7 +561,7 @@ impl CostToGo {
                 search.settled -= 1;
             }
             record.set_dist(d);
-            let key = d.saturating_add(Cost(turns + self.aim_cells(search.aim, a, b)));
+            let key = d.saturating_add(Cost(turns + self.aim_cells(aim, a, b)));
             search.queue.push(key, n as u32);
         }
     }
@@ -594,9 +606,8 @@ impl Search {
             nodes,
             queue,
             settled: 0,
-            aim: (0, 0, 0),
+            aim: None,
             roots: roots.to_vec(),
-            started: false,
             frozen: None,
             cap: MAX_DIST,
             capped: false,
@@ -811,8 +822,8 @@ fn min_weight(lattice: &Lattice, move_weight: &[f64], turn_length: f64, shift_st
 /// `ramp_far` 0.5 % of the expansions against 15 %). Deterministic, and cheaper than a
 /// binary heap of millions of entries. The width is a power of two (the largest not
 /// above the lightest edge), so that a bucket is a shift, not a division per queued
-/// node: splitting it further (4 or 16 buckets to the edge) reopened almost nothing but
-/// took longer, in more buckets' allocations.
+/// node: splitting it further (2, 4 or 16 buckets to the edge) reopened almost nothing
+/// but was no faster, in more buckets' allocations.
 #[derive(Debug)]
 struct Buckets {
     /// log₂ of the width.
@@ -1110,17 +1121,14 @@ mod tests {
             let mut poses = pose_cache(&ctg, &maps);
             let (nx, ny) = (i32::from(lattice.nx), i32::from(lattice.ny));
             let cells = ctg.cells();
-            let at = |n: usize| {
-                let cell = n % cells;
-                ((cell % nx as usize) as i32, (cell / nx as usize) as i32, n / cells)
-            };
             let aims = [(0, 0, 0), (nx - 1, ny - 1, ctg.layers / 2), (100, 32, 0), (60, 50, 1)];
             let mut edges = 0;
             for c in (0..ctg.layers * cells).step_by(7) {
                 for (n, w) in in_edges(&ctg, &maps, &mut poses, c) {
                     for &aim in &aims {
                         let aim = (aim.0, aim.1, aim.2 % ctg.layers);
-                        let (hc, hn) = (ctg.aim_bound(aim, at(c)), ctg.aim_bound(aim, at(n)));
+                        let (hc, hn) =
+                            (ctg.aim_bound(aim, ctg.coords(c)), ctg.aim_bound(aim, ctg.coords(n)));
                         assert!(
                             hc <= w.saturating_add(hn),
                             "{groups}: {c} <- {n}: {hc} > {w} + {hn}"
@@ -1143,10 +1151,10 @@ mod tests {
         let probe = CostToGo::new(lattice, &driving, step, GOAL, (64, usize::MAX));
         let want = reference_distances(&probe, &maps, node_of(&probe, GOAL.0, GOAL.1, 0));
         let (nx, ny) = (i16::try_from(lattice.nx).unwrap(), i16::try_from(lattice.ny).unwrap());
+        // With one group per orientation, a node's layer is its orientation.
         let cell_of = |n: usize| {
-            let (t, cell) = (n / probe.cells(), n % probe.cells());
-            let nx = usize::from(lattice.nx);
-            ((cell % nx) as i16, (cell / nx) as i16, t as u8)
+            let (i, j, t) = probe.coords(n);
+            (i as i16, j as i16, t as u8)
         };
         // The farthest node with a path, one at the median distance, one straight behind
         // the goal and the goal itself.
